@@ -1,0 +1,13 @@
+"""Errors reported to the user as one line naming file, entry and reason."""
+
+
+class SpecError(Exception):
+    """A malformed, duplicate or dangling entry in spec/ (or in a model/vector file)."""
+
+    def __init__(self, file, entry, reason):
+        self.file, self.entry, self.reason = str(file), str(entry), str(reason)
+        super().__init__(f"{self.file}: {self.entry}: {self.reason}")
+
+
+class PipelineError(Exception):
+    """A pipeline step failed (property violated, tool missing, empty result...)."""

@@ -1,0 +1,1068 @@
+"""Render the assessor's evidence package and hash it into a manifest.
+
+``python -m railproof_testgen evidence --spec SPEC --results RESULTS --src REPO --out OUT``
+
+1. reads spec/ (requirements, hazards, assumptions, parameters) and the pipeline's result
+   files (spin/*.json, vectors/*.jsonl + *.coverage.json, tests/**/*.xml, analysis/*.json,
+   trace.json; formats: spec/design/telegram-layer.md §8) plus optional tool versions;
+2. copies every input verbatim to OUT/inputs, copies the Sphinx sources of REPO/evidence to
+   OUT/src and writes the generated reStructuredText pages beside them (rendered from the
+   Jinja templates in evidence/templates): one sphinx-needs need per requirement, hazard,
+   assumption, model property, mutant, vector and analysis result, JUnit results through
+   sphinx-test-reports;
+3. runs ``sphinx-build -b html`` into OUT/html with SOURCE_DATE_EPOCH, PYTHONHASHSEED and the
+   locale fixed, fails on any error, and writes OUT/manifest.json + OUT/manifest.sha256
+   (SHA-256 of every input copy, generated source and rendered file) and OUT/evidence.json
+   (machine-readable verdict and counts).
+
+The HTML is produced by Sphinx alone; this module only writes reStructuredText.
+"""
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import re
+import shlex
+import shutil
+import subprocess
+import sys
+import xml.etree.ElementTree as ET
+from dataclasses import dataclass, field
+from importlib import metadata
+from pathlib import Path
+
+from . import spec as spec_mod
+from .errors import PipelineError, SpecError
+
+MANIFEST_SCHEMA = "railproof/manifest/1"
+TRACE_SCHEMA = "railproof/trace/1"
+# 1980-01-01T00:00:00Z: a fixed date for Sphinx's date-dependent values (the package shows
+# no build date at all; this only keeps any date Sphinx computes independent of the clock).
+SOURCE_DATE_EPOCH = "315532800"
+
+EXCLUDED = {
+    ".doctrees/": "Sphinx's pickled build environment: holds absolute paths and object "
+                  "reprs, differs between build directories; deleted after the build",
+    "html/.buildinfo": "Sphinx's incremental-build stamp: hash of the configuration, which "
+                       "includes the absolute path of the input copies (tr_rootdir)",
+    "html/schema_violations.json": "sphinx-needs' schema validation report: records the "
+                                   "validation's wall-clock duration and rate (no setting turns "
+                                   "this off); its findings are Sphinx warnings, which the build "
+                                   "requires to be absent",
+    "sphinx-output.log": "console output of sphinx-build: names absolute paths",
+    "sphinx-warnings.log": "warnings of sphinx-build: names absolute paths (must be empty)",
+    "**/__pycache__/": "Python byte code (not written: PYTHONDONTWRITEBYTECODE=1)",
+}
+
+_NEED_ID_BAD = re.compile(r"[^A-Za-z0-9_-]+")
+_RST_SPECIAL = re.compile(r"([\\`*_|])")
+_RST_BLOCK_START = re.compile(r"^(?:[-+•]\s|\d+[.)]\s|[a-zA-Z#][.)]\s|\.\.(?:\s|$)|::|>>>)")
+
+
+def _log(msg: str) -> None:
+    print(f"evidence: {msg}", file=sys.stderr, flush=True)
+
+
+# --------------------------------------------------------------------------------------
+# small helpers
+
+
+def need_id(*parts: str, upper: bool = True) -> str:
+    """A sphinx-needs id from free text: [A-Za-z0-9_-] only (upper case unless upper=False),
+    starting with a letter; matches needs_id_regex in evidence/conf.py."""
+    text = "_".join(p for p in parts if p)
+    nid = _NEED_ID_BAD.sub("_", text.upper() if upper else text).strip("_")
+    if not nid or not nid[0].isalpha():
+        nid = "X_" + nid
+    return nid
+
+
+def rst_escape(value) -> str:
+    """Escape inline reStructuredText markup characters; newlines become spaces; a leading
+    list, enumeration or comment marker is escaped so a table cell stays one paragraph."""
+    text = _RST_SPECIAL.sub(r"\\\1", " ".join(str(value).split()))
+    if _RST_BLOCK_START.match(text):
+        text = "\\" + text
+    return text
+
+
+def one_line(value) -> str:
+    """Directive arguments and option values: one line, no leading/trailing blanks."""
+    return " ".join(str(value).split())
+
+
+def fmt_value(v) -> str:
+    """Numbers for tables: integers as is, floats with six significant digits or in
+    scientific notation, booleans as yes/no, lists joined by commas."""
+    if v is None:
+        return "n/a"
+    if isinstance(v, bool):
+        return "yes" if v else "no"
+    if isinstance(v, int):
+        return str(v)
+    if isinstance(v, float):
+        if v == 0.0:
+            return "0"
+        if 1e-3 <= abs(v) < 1e6:
+            return f"{v:.6g}"
+        return f"{v:.3e}"
+    if isinstance(v, (list, tuple)):
+        return ", ".join(fmt_value(x) for x in v)
+    if isinstance(v, dict):
+        return ", ".join(f"{k}={fmt_value(x)}" for k, x in v.items())
+    return str(v)
+
+
+def safe_json_line(obj) -> str:
+    """One JSON line for display inside need content. sphinx-needs treats ``[[`` ... ``]]``
+    in need content as a dynamic function, so adjacent brackets are spaced apart (the
+    verbatim file is linked beside it)."""
+    text = json.dumps(obj, sort_keys=True, ensure_ascii=False)
+    text = re.sub(r"\[(?=\[)", "[ ", text)
+    return re.sub(r"\](?=\])", "] ", text)
+
+
+def sha256_file(path: Path) -> str:
+    h = hashlib.sha256()
+    with Path(path).open("rb") as fh:
+        for chunk in iter(lambda: fh.read(1 << 20), b""):
+            h.update(chunk)
+    return h.hexdigest()
+
+
+def _load_json(path: Path, what: str):
+    try:
+        text = path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise PipelineError(f"{path}: {what} not found") from None
+    except OSError as exc:
+        raise PipelineError(f"{path}: cannot read {what}: {exc.strerror}") from None
+    try:
+        return json.loads(text)
+    except json.JSONDecodeError as exc:
+        raise PipelineError(f"{path}: malformed JSON at line {exc.lineno}: {exc.msg}") from None
+
+
+def _require(cond: bool, path: Path, entry: str, reason: str) -> None:
+    if not cond:
+        raise PipelineError(f"{path}: {entry}: {reason}")
+
+
+# --------------------------------------------------------------------------------------
+# inputs
+
+
+@dataclass
+class InputFile:
+    source: Path      # where it was read
+    rel: str          # path under OUT/inputs (posix)
+
+
+@dataclass
+class JUnitCase:
+    suite: str
+    classname: str
+    name: str
+    result: str       # passed | failure | error | skipped
+    time: str
+
+
+@dataclass
+class JUnitFile:
+    rel: str          # relative to the results directory (posix)
+    suites: list      # [(suite name, [JUnitCase], nested)]
+    error_elements: int = 0
+
+
+@dataclass
+class Inputs:
+    spec_dir: Path
+    results_dir: Path
+    repo_root: Path
+    requirements: list = field(default_factory=list)
+    hazards: list = field(default_factory=list)
+    assumptions: list = field(default_factory=list)
+    parameters: dict = field(default_factory=dict)
+    trace: dict = field(default_factory=dict)
+    spin: list = field(default_factory=list)          # [(rel, data)]
+    vectors: list = field(default_factory=list)       # [(rel, header, [vector])]
+    coverage: list = field(default_factory=list)      # [(rel, data)]
+    junit: list = field(default_factory=list)         # [JUnitFile]
+    analysis: list = field(default_factory=list)      # [(rel, data)]
+    tool_versions: dict | None = None
+    tool_versions_name: str | None = None
+    files: list = field(default_factory=list)         # [InputFile]
+    missing: list = field(default_factory=list)       # notes: inputs not available
+
+
+def _rel(path: Path, base: Path) -> str:
+    return path.relative_to(base).as_posix()
+
+
+def _load_spec(inp: Inputs) -> None:
+    spec_dir = inp.spec_dir
+    if not spec_dir.is_dir():
+        raise PipelineError(f"{spec_dir}: specification directory not found")
+    req_files = spec_mod.spec_files(spec_dir, "requirements")
+    if not req_files:
+        raise PipelineError(f"{spec_dir / 'requirements'}: no requirement files (*.yaml) found")
+    seen = set()
+    for kind, key, target in (("requirements", "requirements", inp.requirements),
+                              ("hazards", "hazards", inp.hazards),
+                              ("assumptions", "assumptions", inp.assumptions)):
+        files = spec_mod.spec_files(spec_dir, kind)
+        if not files:
+            inp.missing.append(f"spec/{kind}")
+        for f in files:
+            data = spec_mod.load_yaml(f)
+            entries = data.get(key) or []
+            if not isinstance(entries, list):
+                raise SpecError(f, key, "must be a list")
+            for i, e in enumerate(entries):
+                if not isinstance(e, dict) or "id" not in e:
+                    raise SpecError(f, f"{key}[{i}]", "entry needs an 'id'")
+                if e["id"] in seen:
+                    raise SpecError(f, e["id"], "duplicate id")
+                seen.add(e["id"])
+                target.append(dict(e, _file=f.name, _area=data.get("area", "")))
+            inp.files.append(InputFile(f, f"spec/{_rel(f, spec_dir)}"))
+    params = spec_mod.load_parameters(spec_dir)
+    inp.parameters = params
+    for area in sorted(params):
+        f = Path(params[area]["file"])
+        inp.files.append(InputFile(f, f"spec/{_rel(f, spec_dir)}"))
+    if not params:
+        inp.missing.append("spec/parameters")
+
+
+def _load_trace(inp: Inputs) -> None:
+    path = inp.results_dir / "trace.json"
+    if not path.is_file():
+        raise PipelineError(f"{path}: trace.json not found (the traceability step writes it; "
+                            "run it before rendering the evidence)")
+    data = _load_json(path, "trace.json")
+    _require(isinstance(data, dict), path, "-", "top level must be an object")
+    _require(data.get("schema") == TRACE_SCHEMA, path, "schema",
+             f"expected {TRACE_SCHEMA!r}, got {data.get('schema')!r}")
+    reqs = data.get("requirements")
+    _require(isinstance(reqs, list), path, "requirements", "must be a list")
+    for i, r in enumerate(reqs):
+        _require(isinstance(r, dict) and "id" in r, path, f"requirements[{i}]", "needs an 'id'")
+        _require(isinstance(r.get("links", {}), dict), path, r["id"], "'links' must be an object")
+    inp.trace = data
+    inp.files.append(InputFile(path, "results/trace.json"))
+
+
+def _load_spin(inp: Inputs) -> None:
+    files = sorted((inp.results_dir / "spin").glob("*.json"))
+    if not files:
+        inp.missing.append("results/spin/*.json (model checking)")
+    for f in files:
+        data = _load_json(f, "SPIN result")
+        _require(isinstance(data, dict), f, "-", "top level must be an object")
+        for key in ("properties", "mutants"):
+            _require(isinstance(data.get(key, []), list), f, key, "must be a list")
+        for i, p in enumerate(data.get("properties", [])):
+            _require(isinstance(p, dict) and "name" in p and "verdict" in p, f,
+                     f"properties[{i}]", "needs 'name' and 'verdict'")
+        for i, m in enumerate(data.get("mutants", [])):
+            _require(isinstance(m, dict) and "name" in m and "verdict" in m, f,
+                     f"mutants[{i}]", "needs 'name' and 'verdict'")
+        rel = _rel(f, inp.results_dir)
+        inp.spin.append((rel, data))
+        inp.files.append(InputFile(f, f"results/{rel}"))
+
+
+def _load_vectors(inp: Inputs) -> None:
+    vdir = inp.results_dir / "vectors"
+    files = sorted(vdir.glob("*.jsonl"))
+    if not files:
+        inp.missing.append("results/vectors/*.jsonl (conformance vectors)")
+    seen = {}
+    for f in files:
+        header, vectors = None, []
+        with f.open(encoding="utf-8") as fh:
+            for lineno, line in enumerate(fh, 1):
+                if not line.strip():
+                    continue
+                try:
+                    obj = json.loads(line)
+                except json.JSONDecodeError as exc:
+                    raise PipelineError(f"{f}: line {lineno}: malformed JSON: {exc.msg}") from None
+                _require(isinstance(obj, dict), f, f"line {lineno}", "must be an object")
+                if obj.get("kind") == "header":
+                    _require(header is None and not vectors, f, f"line {lineno}",
+                             "the header must be the first line and appear once")
+                    header = obj
+                    continue
+                _require(header is not None, f, f"line {lineno}", "vector before the header line")
+                _require(isinstance(obj.get("id"), str) and obj["id"], f, f"line {lineno}",
+                         "vector needs an 'id'")
+                _require(obj["id"] not in seen, f, obj["id"],
+                         f"duplicate vector id (also in {seen.get(obj['id'])})")
+                seen[obj["id"]] = f.name
+                vectors.append(obj)
+        _require(header is not None, f, "line 1", "missing header line")
+        rel = _rel(f, inp.results_dir)
+        inp.vectors.append((rel, header, vectors))
+        inp.files.append(InputFile(f, f"results/{rel}"))
+    cfiles = sorted(vdir.glob("*.coverage.json"))
+    if not cfiles:
+        inp.missing.append("results/vectors/*.coverage.json (goal coverage)")
+    for f in cfiles:
+        data = _load_json(f, "goal coverage")
+        _require(isinstance(data, dict) and isinstance(data.get("goals"), list), f, "goals",
+                 "must be a list")
+        for i, g in enumerate(data["goals"]):
+            _require(isinstance(g, dict) and "id" in g and "status" in g, f, f"goals[{i}]",
+                     "needs 'id' and 'status'")
+        rel = _rel(f, inp.results_dir)
+        inp.coverage.append((rel, data))
+        inp.files.append(InputFile(f, f"results/{rel}"))
+
+
+def _parse_junit(path: Path, rel: str) -> JUnitFile:
+    try:
+        root = ET.parse(path).getroot()
+    except ET.ParseError as exc:
+        raise PipelineError(f"{path}: malformed JUnit XML: {exc}") from None
+    if root.tag not in ("testsuites", "testsuite"):
+        raise PipelineError(f"{path}: not JUnit XML (root element <{root.tag}>)")
+    suites, errors = [], 0
+    top = [root] if root.tag == "testsuite" else root.findall("testsuite")
+    for ts in top:
+        # Suites nested below the top level are flattened and flagged: sphinx-test-reports
+        # 1.3.1 looks suites up by name at the top level only, so those are shown as tables.
+        for s in ts.iter("testsuite"):
+            cases = []
+            for tc in s.findall("testcase"):
+                if tc.find("failure") is not None:
+                    result = "failure"
+                elif tc.find("error") is not None:
+                    result, errors = "error", errors + 1
+                elif tc.find("skipped") is not None:
+                    result = "skipped"
+                else:
+                    result = "passed"
+                cases.append(JUnitCase(s.get("name", "unknown"), tc.get("classname", "unknown"),
+                                       tc.get("name", "unknown"), result, tc.get("time", "")))
+            if cases:
+                suites.append((s.get("name", "unknown"), cases, s is not ts))
+    return JUnitFile(rel, suites, errors)
+
+
+def _load_tests(inp: Inputs) -> None:
+    tdir = inp.results_dir / "tests"
+    files = sorted(p for p in tdir.rglob("*.xml") if p.is_file()) if tdir.is_dir() else []
+    if not files:
+        inp.missing.append("results/tests/**/*.xml (unit and conformance test results)")
+    for f in files:
+        rel = _rel(f, inp.results_dir)
+        inp.junit.append(_parse_junit(f, rel))
+        inp.files.append(InputFile(f, f"results/{rel}"))
+
+
+def _load_analysis(inp: Inputs) -> None:
+    files = sorted((inp.results_dir / "analysis").glob("*.json"))
+    if not files:
+        inp.missing.append("results/analysis/*.json (offline analyses)")
+    for f in files:
+        data = _load_json(f, "analysis result")
+        _require(isinstance(data, dict), f, "-", "top level must be an object")
+        rel = _rel(f, inp.results_dir)
+        inp.analysis.append((rel, data))
+        inp.files.append(InputFile(f, f"results/{rel}"))
+
+
+def _load_tool_versions(inp: Inputs, path: Path | None) -> None:
+    if path is None:
+        inp.missing.append("tool versions (--tool-versions)")
+        return
+    data = _load_json(path, "tool versions")
+    _require(isinstance(data, dict), path, "-", "top level must be an object")
+    inp.tool_versions = data
+    inp.tool_versions_name = path.name
+    inp.files.append(InputFile(path, f"tool-versions/{path.name}"))
+
+
+def load_inputs(spec_dir: Path, results_dir: Path, repo_root: Path,
+                tool_versions: Path | None = None) -> Inputs:
+    inp = Inputs(Path(spec_dir), Path(results_dir), Path(repo_root))
+    _load_spec(inp)
+    if not inp.results_dir.is_dir():
+        raise PipelineError(f"{inp.results_dir}: results directory not found")
+    _load_trace(inp)
+    _load_spin(inp)
+    _load_vectors(inp)
+    _load_tests(inp)
+    _load_analysis(inp)
+    _load_tool_versions(inp, Path(tool_versions) if tool_versions else None)
+    return inp
+
+
+# --------------------------------------------------------------------------------------
+# page model: plain dicts handed to the Jinja templates
+
+
+def _tokens(text: str) -> tuple:
+    return tuple(t for t in re.split(r"[^A-Z0-9]+", text.upper()) if t)
+
+
+def _contains_seq(hay: tuple, needle: tuple) -> bool:
+    n = len(needle)
+    return n > 0 and any(hay[i:i + n] == needle for i in range(len(hay) - n + 1))
+
+
+def _case_keys(c: JUnitCase) -> set:
+    keys = {f"{c.classname}.{c.name}", f"{c.classname}::{c.name}", f"{c.suite}.{c.name}"}
+    if "." in c.classname:   # pytest: tests.test_x + test_y  <->  tests/test_x.py::test_y
+        keys.add(c.classname.replace(".", "/") + ".py::" + c.name)
+    return keys
+
+
+def _unit_match(test: str, keys: set, name: str) -> bool:
+    if test in keys or test == name:
+        return True
+    return any(test.endswith("/" + k) for k in keys if "::" in k)
+
+
+class Model:
+    """Everything the templates show, computed once from the inputs."""
+
+    def __init__(self, inp: Inputs, command: str):
+        self.inp = inp
+        self.command = command
+        self.need_ids: set = set()
+        self.problems: list = []       # reasons for a FAIL verdict
+        self.incomplete: list = list(inp.missing)
+        self._spec()
+        self._trace()
+        self._spin()
+        self._vectors()
+        self._coverage()
+        self._tests()
+        self._analysis()
+        self._requirement_links()
+        self._versions()
+        self._verdict()
+
+    # -- spec -----------------------------------------------------------------------------
+    def _claim(self, nid: str, what: str) -> str:
+        if nid in self.need_ids:
+            raise PipelineError(f"two inputs map to the same need id {nid} ({what})")
+        self.need_ids.add(nid)
+        return nid
+
+    def _readable(self, *parts: str, limit: int = 72) -> str:
+        """A readable need id for a test item; long names keep a hash suffix, and a clash
+        with an earlier id gets _2, _3 ... (inputs are processed in a fixed order)."""
+        nid = need_id(*parts, upper=False)
+        if len(nid) > limit:
+            digest = hashlib.sha256("\0".join(parts).encode()).hexdigest()[:8].upper()
+            nid = nid[:limit - 9].rstrip("_-") + "_" + digest
+        base, n = nid, 1
+        while nid in self.need_ids:
+            n += 1
+            nid = f"{base}_{n}"
+        self.need_ids.add(nid)
+        return nid
+
+    def _spec(self):
+        inp = self.inp
+        self.hazard_ids = {h["id"] for h in inp.hazards}
+        self.asm_ids = {a["id"] for a in inp.assumptions}
+        self.req_ids = {r["id"] for r in inp.requirements}
+        self.hazards = []
+        for h in inp.hazards:
+            self.hazards.append({"id": self._claim(h["id"], "hazard"), "title": h.get("title", h["id"]),
+                                 "text": h.get("text", ""), "severity": h.get("severity", ""),
+                                 "source": "; ".join(map(str, h.get("source") or []))})
+        self.assumptions = []
+        for a in inp.assumptions:
+            self.assumptions.append({"id": self._claim(a["id"], "assumption"),
+                                     "title": a.get("title", a["id"]), "text": a.get("text", ""),
+                                     "source": "; ".join(map(str, a.get("source") or []))})
+        self.parameters = []
+        for area in sorted(inp.parameters):
+            d = inp.parameters[area]
+            self.parameters.append({
+                "area": area, "file": Path(d["file"]).name,
+                "parameters": [{"id": k, "value": fmt_value(e["value"]), "unit": e.get("unit", ""),
+                                "source": e.get("source", ""),
+                                "requirements": ", ".join(e.get("requirements") or [])}
+                               for k, e in d["parameters"].items()],
+                "bounds": [{"id": k, "value": fmt_value(e["value"]), "rationale": e.get("rationale", "")}
+                           for k, e in d["model_bounds"].items()]})
+
+    # -- trace ----------------------------------------------------------------------------
+    def _trace(self):
+        t = self.inp.trace
+        self.trace_by_id = {r["id"]: r for r in t.get("requirements", [])}
+        self.trace_errors = [str(e) for e in t.get("errors") or []]
+        self.trace_warnings = [str(w) for w in t.get("warnings") or []]
+        self.trace_summary = [(str(k), fmt_value(v)) for k, v in (t.get("summary") or {}).items()]
+        self.trace_unknown = sorted(set(self.trace_by_id) - self.req_ids)
+        if self.trace_errors:
+            self.problems.append(f"traceability check reported {len(self.trace_errors)} error(s)")
+        for rid in self.trace_unknown:
+            self.problems.append(f"trace.json names {rid}, which is not in the specification")
+
+    # -- model checking -------------------------------------------------------------------
+    def _spin(self):
+        self.models = []
+        self.prop_by_name = {}
+        for rel, d in self.inp.spin:
+            stem = Path(rel).stem
+            model = str(d.get("model", stem))
+            sha = str(d.get("model_sha256", ""))
+            src = self.inp.repo_root / model
+            if not sha:
+                src_check = "no model hash in the result"
+            elif src.is_file():
+                src_check = ("matches the source tree" if sha256_file(src) == sha
+                             else "DIFFERS from the source tree")
+            else:
+                src_check = "model file not in the source tree"
+            props = []
+            for p in d.get("properties", []):
+                nid = self._readable("PROP", p["name"]) if need_id("PROP", p["name"], upper=False) \
+                    not in self.need_ids else self._readable("PROP", stem, p["name"])
+                reqs = [r for r in p.get("requirements") or []]
+                links = [r for r in reqs if r in self.req_ids]
+                unknown = [r for r in reqs if r not in self.req_ids]
+                verdict = str(p["verdict"])
+                for r in unknown:
+                    self.problems.append(f"model property {p['name']} names unknown requirement {r}")
+                if verdict != "verified":
+                    self.problems.append(f"model property {p['name']} ({model}): {verdict}")
+                extra = {k: fmt_value(v) for k, v in p.items()
+                         if k not in ("name", "requirements", "verdict", "states_stored", "depth",
+                                      "errors", "time_s", "memory_mb")}
+                props.append({"id": nid, "name": p["name"], "verdict": verdict,
+                              "states": fmt_value(p.get("states_stored")),
+                              "depth": fmt_value(p.get("depth")),
+                              "errors": fmt_value(p.get("errors")),
+                              "time_s": fmt_value(p.get("time_s")),
+                              "memory_mb": fmt_value(p.get("memory_mb")),
+                              "links": links, "unknown": unknown, "extra": sorted(extra.items())})
+                self.prop_by_name.setdefault(p["name"], nid)
+                self.prop_by_name[(model, p["name"])] = nid
+            mutants = []
+            for m in d.get("mutants", []):
+                nid = self._readable("MUT", m["name"]) if need_id("MUT", m["name"], upper=False) \
+                    not in self.need_ids else self._readable("MUT", stem, m["name"])
+                expect = str(m.get("expect", "rejected"))
+                verdict = str(m["verdict"])
+                if verdict != expect:
+                    self.problems.append(f"mutant {m['name']} ({model}): {verdict}, expected {expect}")
+                target = next((p["id"] for p in props if p["name"] == m.get("property")), None)
+                mutants.append({"id": nid, "name": m["name"], "expect": expect, "verdict": verdict,
+                                "property": m.get("property") or "", "target": target,
+                                "extra": sorted((k, fmt_value(v)) for k, v in m.items() if k not in
+                                                ("name", "expect", "verdict", "property"))})
+            bounds = [(str(k), fmt_value(v)) for k, v in (d.get("bounds") or {}).items()]
+            other = [(str(k), fmt_value(v)) for k, v in d.items()
+                     if k not in ("model", "model_sha256", "spin_version", "bounds", "properties",
+                                  "mutants")]
+            self.models.append({"rel": rel, "stem": stem, "model": model, "sha": sha,
+                                "src_check": src_check, "spin_version": str(d.get("spin_version", "n/a")),
+                                "bounds": bounds, "other": other, "properties": props,
+                                "mutants": mutants,
+                                "verified": sum(p["verdict"] == "verified" for p in props),
+                                "rejected": sum(m["verdict"] == m["expect"] for m in mutants)})
+            if src_check.startswith("DIFFERS"):
+                self.problems.append(f"{model}: model hash in {rel} differs from the source tree")
+
+    # -- vectors --------------------------------------------------------------------------
+    def _vectors(self):
+        self.vector_files = []
+        self.vector_by_id = {}
+        for rel, header, vectors in self.inp.vectors:
+            stem = Path(rel).name[:-len(".jsonl")]
+            by_req: dict = {}
+            items = []
+            for v in vectors:
+                nid = self._claim(need_id(v["id"], upper=False), f"vector {v['id']}")
+                reqs = [str(r) for r in v.get("requirements") or []]
+                steps = v.get("steps") or []
+                item = {"id": nid, "orig": v["id"], "goal": str(v.get("goal", "")),
+                        "title": str(v.get("goal") or v["id"]),
+                        "links": [r for r in reqs if r in self.req_ids],
+                        "unknown": [r for r in reqs if r not in self.req_ids],
+                        "nsteps": len(steps), "steps": [safe_json_line(s) for s in steps],
+                        "extra": sorted((k, fmt_value(x)) for k, x in v.items()
+                                        if k not in ("id", "requirements", "goal", "steps"))}
+                items.append(item)
+                self.vector_by_id[v["id"]] = nid
+                home = reqs[0] if reqs else "(no requirement)"
+                by_req.setdefault(home, []).append(item)
+                for r in item["unknown"]:
+                    self.problems.append(f"vector {v['id']} names unknown requirement {r}")
+            counts: dict = {}
+            for it in items:
+                for r in it["links"] + it["unknown"]:
+                    counts[r] = counts.get(r, 0) + 1
+            hdr = [(k, fmt_value(x)) for k, x in header.items()
+                   if k not in ("kind", "parameters", "unit_scales")]
+            self.vector_files.append({
+                "rel": rel, "stem": stem, "page": f"vectors_{need_id(stem).lower()}",
+                "header": hdr,
+                "unit_scales": [(k, fmt_value(x)) for k, x in (header.get("unit_scales") or {}).items()],
+                "parameters": [(k, fmt_value(x)) for k, x in (header.get("parameters") or {}).items()],
+                "count": len(items), "steps": sum(i["nsteps"] for i in items),
+                "groups": [(r, by_req[r]) for r in sorted(by_req)],
+                "per_req": sorted(counts.items())})
+        if self.inp.vectors and not any(f["count"] for f in self.vector_files):
+            self.problems.append("the vector files hold no vectors")
+
+    def _coverage(self):
+        self.coverage = []
+        for rel, d in self.inp.coverage:
+            goals = []
+            for g in d["goals"]:
+                status = str(g["status"])
+                vec = g.get("vector")
+                just = g.get("justification")
+                ok = (status == "reached" and vec) or (status == "unreachable" and just)
+                if not ok:
+                    self.problems.append(f"goal {g['id']} ({rel}): {status} without "
+                                         f"{'vector' if status == 'reached' else 'justification'}")
+                goals.append({"id": str(g["id"]), "label": str(g.get("label", "")),
+                              "requirements": ", ".join(g.get("requirements") or []),
+                              "status": status, "vector": vec,
+                              "vector_need": self.vector_by_id.get(vec) if vec else None,
+                              "justification": just or ""})
+            reached = d.get("reached", sum(g["status"] == "reached" for g in goals))
+            labelled = d.get("labelled", len(goals))
+            extra = [(k, fmt_value(v)) for k, v in d.items() if k not in ("goals", "reached", "labelled")]
+            self.coverage.append({"rel": rel, "goals": goals, "reached": reached, "labelled": labelled,
+                                  "unreachable": [g for g in goals if g["status"] == "unreachable"],
+                                  "extra": extra})
+
+    # -- tests ----------------------------------------------------------------------------
+    def _tests(self):
+        unit_map = []   # (test string, requirement)
+        for rid, r in self.trace_by_id.items():
+            for u in (r.get("links") or {}).get("unit") or []:
+                if isinstance(u, dict) and u.get("test"):
+                    unit_map.append((str(u["test"]), rid))
+        vec_tokens = [(_tokens(vid), nid) for vid, nid in self.vector_by_id.items()]
+        self.case_by_test = {}
+        self.test_files = []
+        totals = {"passed": 0, "failure": 0, "error": 0, "skipped": 0}
+        for jf in self.inp.junit:
+            fid = self._readable("TF", jf.rel.removeprefix("tests/").removesuffix(".xml"))
+            suites = []
+            counts = {"passed": 0, "failure": 0, "error": 0, "skipped": 0}
+            for sname, cases, nested in jf.suites:
+                sid = self._readable("TS", sname)
+                items = []
+                for c in cases:
+                    cid = self._readable("TC", c.classname, c.name)
+                    keys = _case_keys(c)
+                    reqs = sorted({rid for test, rid in unit_map if _unit_match(test, keys, c.name)})
+                    toks = _tokens(f"{c.classname} {c.name}")
+                    vecs = sorted({nid for vt, nid in vec_tokens if _contains_seq(toks, vt)})
+                    counts[c.result] += 1
+                    if c.result in ("failure", "error"):
+                        self.problems.append(f"test {c.classname}.{c.name} ({jf.rel}): {c.result}")
+                    items.append({"id": cid, "suite": sname, "classname": c.classname, "name": c.name,
+                                  "result": c.result, "verifies": reqs, "vectors": vecs})
+                    for k in keys | {c.name}:
+                        self.case_by_test.setdefault(k, cid)
+                suites.append({"id": sid, "name": sname, "cases": items, "nested": nested})
+            for k in totals:
+                totals[k] += counts[k]
+            self.test_files.append({"id": fid, "rel": jf.rel, "suites": suites, "counts": counts,
+                                    "cases": sum(len(s["cases"]) for s in suites),
+                                    "error_elements": jf.error_elements})
+        self.test_totals = totals
+
+    # -- analysis -------------------------------------------------------------------------
+    def _analysis(self):
+        self.analyses = []
+        for rel, d in self.inp.analysis:
+            stem = Path(rel).stem
+            nid = self._claim(need_id("RES", stem), f"analysis {rel}")
+            reqs = [str(r) for r in d.get("requirements") or []]
+            scalars, tables, fails = [], [], []
+            for k, v in d.items():
+                if k == "requirements":
+                    continue
+                if isinstance(v, list) and v and all(isinstance(x, dict) for x in v):
+                    cols = []
+                    for row in v:
+                        for c in row:
+                            if c not in cols:
+                                cols.append(c)
+                    rows = [[fmt_value(row.get(c)) for c in cols] for row in v]
+                    tables.append({"name": k, "columns": cols, "rows": rows})
+                    for i, row in enumerate(v):
+                        if row.get("meets_target") is False:
+                            fails.append(f"{k}[{i}]")
+                else:
+                    scalars.append((k, fmt_value(v)))
+                    if k == "meets_target" and v is False:
+                        fails.append(k)
+            for r in reqs:
+                if r not in self.req_ids:
+                    self.problems.append(f"analysis {rel} names unknown requirement {r}")
+            outcome = "fail" if fails else "pass"
+            if fails:
+                self.problems.append(f"analysis {rel}: target not met in {', '.join(fails)}")
+            self.analyses.append({"id": nid, "rel": rel, "stem": stem,
+                                  "title": stem.replace("_", " "),
+                                  "links": [r for r in reqs if r in self.req_ids],
+                                  "unknown": [r for r in reqs if r not in self.req_ids],
+                                  "scalars": scalars, "tables": tables, "outcome": outcome,
+                                  "fails": fails})
+
+    # -- requirements with their trace ----------------------------------------------------
+    def _requirement_links(self):
+        self.requirements = []
+        self.areas = []
+        by_file: dict = {}
+        for r in self.inp.requirements:
+            rid = r["id"]
+            self._claim(rid, "requirement")
+            t = self.trace_by_id.get(rid)
+            links = (t or {}).get("links") or {}
+            status = str(t.get("status", "error")) if t else "untraced"
+            problems = [str(p) for p in (t or {}).get("problems") or []]
+            if not t:
+                problems.append("no entry in trace.json")
+            if status != "ok":
+                self.problems.append(f"{rid}: trace status {status}")
+            model = []
+            for m in links.get("model") or []:
+                if isinstance(m, dict):
+                    name = m.get("property", "")
+                    nid = self.prop_by_name.get((m.get("model"), name)) or self.prop_by_name.get(name)
+                    model.append({"name": name, "verdict": m.get("verdict", ""), "need": nid,
+                                  "model": m.get("model", "")})
+            vecs = [str(v) for v in links.get("vectors") or []]
+            unit = []
+            for u in links.get("unit") or []:
+                if isinstance(u, dict):
+                    test = str(u.get("test", ""))
+                    unit.append({"test": test, "file": str(u.get("file", "")),
+                                 "need": self.case_by_test.get(test)})
+            code = [{"file": str(c.get("file", "")), "unit": str(c.get("unit", ""))}
+                    for c in links.get("code") or [] if isinstance(c, dict)]
+            analysis = [fmt_value(a) for a in links.get("analysis") or []]
+            proof = [fmt_value(p) for p in links.get("proof") or []]
+            goals = [fmt_value(g) for g in links.get("goals") or []]
+            counts = (f"model {len(model)}, goals {len(goals)}, vectors {len(vecs)}, unit {len(unit)}, "
+                      f"code {len(code)}, analysis {len(analysis)}, proof {len(proof)}")
+            src = [str(s) for s in r.get("source") or []]
+            asms = sorted({m for s in src for m in re.findall(r"ASM(?:-[A-Z]+)?-\d+", s)}
+                          | {m for m in re.findall(r"ASM(?:-[A-Z]+)?-\d+", str(r.get("text", "")))})
+            item = {
+                "id": rid, "title": r.get("title", rid), "text": r.get("text", ""),
+                "sil": fmt_value(r.get("sil")), "source": "; ".join(src),
+                "verification": ", ".join(map(str, r.get("verification") or [])),
+                "defence": r.get("defence", ""), "threat": r.get("threat", ""),
+                "hazards": [h for h in r.get("hazards") or [] if h in self.hazard_ids],
+                "hazards_unknown": [h for h in r.get("hazards") or [] if h not in self.hazard_ids],
+                "assumptions": [a for a in asms if a in self.asm_ids],
+                "status": status, "problems": problems, "counts": counts,
+                "model": model, "goals": goals,
+                "vectors": [{"id": v, "need": self.vector_by_id.get(v)} for v in vecs],
+                "unit": unit, "code": code, "analysis": analysis, "proof": proof,
+            }
+            self.requirements.append(item)
+            by_file.setdefault((r["_file"], r.get("_area", "")), []).append(item)
+        for (fname, area), items in by_file.items():
+            self.areas.append({"file": fname, "area": area, "requirements": items})
+        self.req_ok = sum(r["status"] == "ok" for r in self.requirements)
+
+    # -- tool versions --------------------------------------------------------------------
+    def _versions(self):
+        def flat(prefix, v, out):
+            if isinstance(v, dict):
+                for k, x in v.items():
+                    flat(f"{prefix}.{k}" if prefix else str(k), x, out)
+            else:
+                out.append((prefix, fmt_value(v)))
+        self.tool_versions = []
+        if self.inp.tool_versions is not None:
+            flat("", self.inp.tool_versions, self.tool_versions)
+        self.spin_versions = [(m["model"], m["spin_version"]) for m in self.models]
+        self.doc_versions = [("Python", ".".join(map(str, sys.version_info[:3])))]
+        for dist in ("Sphinx", "sphinx-needs", "sphinx-test-reports", "docutils", "Jinja2", "PyYAML"):
+            try:
+                self.doc_versions.append((dist, metadata.version(dist)))
+            except metadata.PackageNotFoundError:
+                self.doc_versions.append((dist, "not installed"))
+        gens = sorted({fmt_value(h.get("generator")) for _, h, _ in self.inp.vectors if h.get("generator")})
+        self.generator_versions = [("vector generator", g) for g in gens]
+
+    # -- overall --------------------------------------------------------------------------
+    def _verdict(self):
+        if self.problems:
+            self.verdict = "FAIL"
+        elif self.incomplete:
+            self.verdict = "INCOMPLETE"
+        else:
+            self.verdict = "PASS"
+        nprops = sum(len(m["properties"]) for m in self.models)
+        nmut = sum(len(m["mutants"]) for m in self.models)
+        self.counts = {
+            "requirements": len(self.requirements), "requirements_ok": self.req_ok,
+            "sil4": sum(1 for r in self.requirements if r["sil"] == "4"),
+            "hazards": len(self.hazards), "assumptions": len(self.assumptions),
+            "models": len(self.models), "properties": nprops,
+            "properties_verified": sum(m["verified"] for m in self.models),
+            "mutants": nmut, "mutants_rejected": sum(m["rejected"] for m in self.models),
+            "vector_files": len(self.vector_files),
+            "vectors": sum(f["count"] for f in self.vector_files),
+            "vector_steps": sum(f["steps"] for f in self.vector_files),
+            "goals_labelled": sum(c["labelled"] for c in self.coverage),
+            "goals_reached": sum(c["reached"] for c in self.coverage),
+            "goals_unreachable": sum(len(c["unreachable"]) for c in self.coverage),
+            "test_files": len(self.test_files),
+            "test_cases": sum(f["cases"] for f in self.test_files),
+            "tests_passed": self.test_totals["passed"], "tests_failed": self.test_totals["failure"],
+            "tests_errors": self.test_totals["error"], "tests_skipped": self.test_totals["skipped"],
+            "analyses": len(self.analyses),
+            "analyses_pass": sum(a["outcome"] == "pass" for a in self.analyses),
+        }
+
+
+# --------------------------------------------------------------------------------------
+# rendering
+
+
+def _jinja_env(template_dir: Path):
+    import jinja2
+
+    env = jinja2.Environment(
+        loader=jinja2.FileSystemLoader(str(template_dir)),
+        undefined=jinja2.StrictUndefined, autoescape=False,
+        trim_blocks=True, lstrip_blocks=True, keep_trailing_newline=True,
+        extensions=["jinja2.ext.do"])
+    env.filters["rst"] = rst_escape
+    env.filters["line"] = one_line
+    env.filters["num"] = fmt_value
+    env.filters["rows"] = lambda items, *keys: [[it.get(k, "") for k in keys] for it in items]
+    env.filters["underline"] = lambda text, ch="=": ch * max(len(str(text)), 3)
+    return env
+
+
+def _write(path: Path, text: str) -> None:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with path.open("w", encoding="utf-8", newline="\n") as fh:
+        fh.write(text)
+
+
+def render_sources(model: Model, evidence_dir: Path, src_dir: Path) -> list:
+    """Copy evidence/ (without its templates) to src_dir and write the generated pages."""
+    template_dir = evidence_dir / "templates"
+    if not (evidence_dir / "conf.py").is_file() or not template_dir.is_dir():
+        raise PipelineError(f"{evidence_dir}: evidence sources (conf.py, templates/) not found")
+    shutil.copytree(evidence_dir, src_dir,
+                    ignore=shutil.ignore_patterns("templates", "__pycache__", "*.pyc", "_build",
+                                                  "README.md"))
+    env = _jinja_env(template_dir)
+    pages = ["overview", "traceability", "hazards", "model_checking", "test_generation",
+             "tests", "analysis", "tool_versions", "manifest"]
+    ctx = {"m": model, "inp": model.inp}
+    for page in pages:
+        _write(src_dir / f"{page}.rst", env.get_template(f"{page}.rst.jinja").render(**ctx))
+    for vf in model.vector_files:
+        _write(src_dir / f"{vf['page']}.rst",
+               env.get_template("vectors.rst.jinja").render(vf=vf, **ctx))
+    _write(src_dir / "replay_commands.inc", env.get_template("replay_commands.inc.jinja").render(**ctx))
+    return pages + [vf["page"] for vf in model.vector_files]
+
+
+def copy_inputs(inp: Inputs, inputs_dir: Path) -> list:
+    """Verbatim copies of every input under OUT/inputs; returns [(rel, sha256, bytes)]."""
+    rows = []
+    for f in sorted(inp.files, key=lambda x: x.rel):
+        dest = inputs_dir / f.rel
+        dest.parent.mkdir(parents=True, exist_ok=True)
+        shutil.copyfile(f.source, dest)
+        rows.append({"path": f"inputs/{f.rel}", "sha256": sha256_file(dest),
+                     "bytes": dest.stat().st_size})
+    return rows
+
+
+def check_toolchain() -> None:
+    """Fail early, in one line, when the documentation tool chain cannot work."""
+    import inspect
+
+    try:
+        import sphinx  # noqa: F401
+        import sphinx_needs.api
+        import sphinxcontrib.test_reports  # noqa: F401
+    except ImportError as exc:
+        raise PipelineError(f"the Sphinx tool chain is not installed ({exc.name}); install "
+                            "testgen/requirements.txt into the Python environment") from None
+    if "schema" not in inspect.signature(sphinx_needs.api.add_extra_option).parameters:
+        raise PipelineError(
+            f"sphinx-needs {metadata.version('sphinx-needs')} cannot run sphinx-test-reports "
+            f"{metadata.version('sphinx-test-reports')}: its add_extra_option() has no 'schema' "
+            "argument (added in sphinx-needs 6.0.1); pin sphinx-needs>=6.0.1")
+
+
+def run_sphinx(src_dir: Path, html_dir: Path, doctree_dir: Path, out_dir: Path) -> int:
+    """sphinx-build -b html with everything that could vary between machines fixed.
+    Returns the number of warnings; raises PipelineError on any error."""
+    env = dict(os.environ)
+    env.update({"SOURCE_DATE_EPOCH": SOURCE_DATE_EPOCH, "PYTHONHASHSEED": "0",
+                "PYTHONDONTWRITEBYTECODE": "1", "TZ": "UTC", "LC_ALL": "C.UTF-8", "LANG": "C.UTF-8"})
+    warn_file = out_dir / "sphinx-warnings.log"
+    log_file = out_dir / "sphinx-output.log"
+    cmd = [sys.executable, "-m", "sphinx", "-b", "html", "-E", "-j", "1", "-d", str(doctree_dir),
+           "-w", str(warn_file), "--keep-going", str(src_dir), str(html_dir)]
+    with log_file.open("w", encoding="utf-8") as log:
+        proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, env=env,
+                                text=True, encoding="utf-8", errors="replace")
+        assert proc.stdout is not None
+        tail: list = []
+        for line in proc.stdout:
+            log.write(line)
+            if line.strip():
+                tail = (tail + [line.strip()])[-40:]
+            line = line.rstrip()
+            if line.startswith(("reading sources", "writing output", "build succeeded",
+                                "build finished", "copying", "generating indices", "dumping")) \
+                    or "ERROR" in line or "WARNING" in line:
+                _log(f"sphinx: {line[:200]}")
+        rc = proc.wait()
+    warnings = warn_file.read_text(encoding="utf-8", errors="replace") if warn_file.exists() else ""
+    errors = [ln for ln in warnings.splitlines()
+              if re.search(r"(?:^|:\s)(?:ERROR|CRITICAL|SEVERE)\b", ln)]
+    if rc != 0 or errors:
+        crash = [ln for ln in tail if re.search(r"error|exception", ln, re.IGNORECASE)]
+        first = errors[0] if errors else (crash or tail or ["no output"])[-1]
+        raise PipelineError(f"sphinx-build failed (exit {rc}, {len(errors)} error(s)): {first.strip()} "
+                            f"[log: {log_file}]")
+    return sum(1 for ln in warnings.splitlines() if "WARNING" in ln)
+
+
+def _walk(base: Path, top: Path, skip) -> list:
+    rows = []
+    for p in sorted(top.rglob("*")):
+        if not p.is_file():
+            continue
+        rel = p.relative_to(base).as_posix()
+        if skip(rel):
+            continue
+        rows.append({"path": rel, "sha256": sha256_file(p), "bytes": p.stat().st_size})
+    return rows
+
+
+def write_manifest(out_dir: Path, input_rows: list) -> dict:
+    def skip(rel: str) -> bool:
+        parts = rel.split("/")
+        return ("__pycache__" in parts or parts[-1].startswith(".buildinfo") or ".doctrees" in parts
+                or rel == "html/schema_violations.json")
+
+    artifacts = list(input_rows)
+    artifacts += _walk(out_dir, out_dir / "src", skip)
+    artifacts += _walk(out_dir, out_dir / "html", skip)
+    artifacts.append({"path": "evidence.json", "sha256": sha256_file(out_dir / "evidence.json"),
+                      "bytes": (out_dir / "evidence.json").stat().st_size})
+    artifacts.sort(key=lambda a: a["path"])
+    manifest = {"schema": MANIFEST_SCHEMA, "algorithm": "sha256", "artifacts": artifacts,
+                "excluded": [{"path": k, "reason": v} for k, v in EXCLUDED.items()]}
+    text = json.dumps(manifest, indent=2, sort_keys=True) + "\n"
+    _write(out_dir / "manifest.json", text)
+    lines = [f"{a['sha256']}  {a['path']}" for a in artifacts]
+    lines.append(f"{hashlib.sha256(text.encode()).hexdigest()}  manifest.json")
+    _write(out_dir / "manifest.sha256", "\n".join(lines) + "\n")
+    return manifest
+
+
+def _display_path(path: Path, repo_root: Path, placeholder: str) -> str:
+    try:
+        return path.resolve().relative_to(repo_root.resolve()).as_posix() or "."
+    except ValueError:
+        return placeholder
+
+
+def _check_out_dir(out_dir: Path, repo_root: Path, spec_dir: Path, results_dir: Path) -> None:
+    out = out_dir.resolve()
+    if out == repo_root.resolve() or out in repo_root.resolve().parents:
+        raise PipelineError(f"{out_dir}: output directory must not be the source tree or above it")
+    for protected, what in ((repo_root / "evidence", "the evidence sources"),
+                            (spec_dir, "the specification"), (results_dir, "the results")):
+        p = protected.resolve()
+        if out == p or p in out.parents or out in p.parents:
+            raise PipelineError(f"{out_dir}: output directory must not overlap {what} ({protected})")
+
+
+def build(spec_dir, results_dir, repo_root, out_dir, tool_versions=None) -> dict:
+    spec_dir, results_dir = Path(spec_dir), Path(results_dir)
+    repo_root, out_dir = Path(repo_root), Path(out_dir)
+    evidence_dir = repo_root / "evidence"
+    _check_out_dir(out_dir, repo_root, spec_dir, results_dir)
+
+    _log(f"reading specification {spec_dir} and results {results_dir}")
+    inp = load_inputs(spec_dir, results_dir, repo_root, tool_versions)
+    check_toolchain()
+    args = [("--spec", _display_path(spec_dir, repo_root, "SPEC_DIR")),
+            ("--results", _display_path(results_dir, repo_root, "RESULTS_DIR")),
+            ("--src", "."), ("--out", "OUT_DIR")]
+    if tool_versions:
+        args.append(("--tool-versions",
+                     _display_path(Path(tool_versions), repo_root, "TOOL_VERSIONS_JSON")))
+    command = " \\\n    ".join(["PYTHONPATH=testgen python -m railproof_testgen evidence"]
+                                  + [f"{k} {shlex.quote(v)}" for k, v in args])
+    model = Model(inp, command)
+    c = model.counts
+    _log(f"rendering {c['requirements']} requirements, {c['hazards']} hazards, "
+         f"{c['assumptions']} assumptions, {c['properties']} properties, {c['mutants']} mutants, "
+         f"{c['vectors']} vectors, {c['test_cases']} test cases, {c['analyses']} analyses")
+    for note in inp.missing:
+        _log(f"not available in this run: {note}")
+
+    out_dir.mkdir(parents=True, exist_ok=True)
+    for sub in ("inputs", "src", "html", ".doctrees"):
+        if (out_dir / sub).exists():
+            shutil.rmtree(out_dir / sub)
+    for f in ("manifest.json", "manifest.sha256", "evidence.json", "sphinx-warnings.log",
+              "sphinx-output.log"):
+        (out_dir / f).unlink(missing_ok=True)
+
+    input_rows = copy_inputs(inp, out_dir / "inputs")
+    model.input_rows = input_rows
+    model.excluded = [[k, v] for k, v in EXCLUDED.items()]
+    pages = render_sources(model, evidence_dir, out_dir / "src")
+    _log(f"wrote {len(pages)} generated pages; running sphinx-build (html)")
+    nwarn = run_sphinx(out_dir / "src", out_dir / "html", out_dir / ".doctrees", out_dir)
+    shutil.rmtree(out_dir / ".doctrees", ignore_errors=True)   # not part of the package
+    if nwarn:
+        _log(f"sphinx-build reported {nwarn} warning(s): see {out_dir / 'sphinx-warnings.log'}")
+
+    summary = {"schema": "railproof/evidence/1", "verdict": model.verdict,
+               "problems": model.problems, "not_available": inp.missing, "counts": c}
+    _write(out_dir / "evidence.json", json.dumps(summary, indent=2, sort_keys=True) + "\n")
+    _log("hashing the package")
+    manifest = write_manifest(out_dir, input_rows)
+    _log(f"wrote {out_dir / 'manifest.json'} ({len(manifest['artifacts'])} artifacts); "
+         f"verdict {model.verdict}")
+    return {"manifest": manifest, "summary": summary, "warnings": nwarn}
+
+
+def _run(a) -> int:
+    build(a.spec, a.results, a.src, a.out, a.tool_versions)
+    return 0
+
+
+def register(sub):
+    p = sub.add_parser(
+        "evidence",
+        help="render the assessor's evidence package (Sphinx + sphinx-needs) and its manifest",
+        description="Render spec/ and the pipeline's results into an HTML evidence package with "
+                    "Sphinx, sphinx-needs and sphinx-test-reports, and write a SHA-256 manifest.")
+    p.add_argument("--spec", required=True, help="spec/ directory")
+    p.add_argument("--results", required=True,
+                   help="results directory (spin/, vectors/, tests/, analysis/, trace.json)")
+    p.add_argument("--src", required=True, help="repository root (its evidence/ holds the sources)")
+    p.add_argument("--out", required=True, help="output directory (inputs/, src/, html/, manifest)")
+    p.add_argument("--tool-versions", default=None, help="JSON object of tool names to versions")
+    p.set_defaults(func=_run)

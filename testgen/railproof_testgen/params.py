@@ -1,0 +1,61 @@
+"""Generate the C++ constants header and the Promela #define header from spec/parameters."""
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+from . import spec as spec_mod
+
+_IDENT = re.compile(r"^[a-z][a-z0-9_]*$")
+
+
+def _cxx_literal(v):
+    if isinstance(v, int):
+        return f"std::int64_t{{{v}}}"
+    return repr(float(v))
+
+
+def _write_if_changed(path: Path, text: str):
+    path.parent.mkdir(parents=True, exist_ok=True)
+    if path.exists() and path.read_text(encoding="utf-8") == text:
+        return
+    tmp = path.with_suffix(path.suffix + ".tmp")
+    tmp.write_text(text, encoding="utf-8")
+    tmp.replace(path)  # atomic: never half-written
+
+
+def generate(spec_dir: Path, out_dir: Path):
+    from .validate import validate_spec; validate_spec(spec_dir)  # noqa: E702
+    areas = spec_mod.load_parameters(spec_dir)
+    for area, data in sorted(areas.items()):
+        name = {"TG": "telegram"}.get(area, area.lower())
+        lines = [
+            "// Generated from spec/parameters by railproof_testgen gen-params. Do not edit.",
+            "#pragma once",
+            "#include <cstdint>",
+            f"namespace railproof::params::{name} {{",
+        ]
+        pml = [f"/* Generated from {Path(data['file']).name} by railproof_testgen. Do not edit. */"]
+        for section, ns in (("parameters", None), ("model_bounds", "model")):
+            entries = data[section]
+            if ns:
+                lines.append(f"namespace {ns} {{")
+            for pid, e in entries.items():
+                if not _IDENT.match(pid):
+                    raise spec_mod.SpecError(data["file"], pid, "id must match [a-z][a-z0-9_]*")
+                lines.append(f"inline constexpr auto {pid} = {_cxx_literal(e['value'])};")
+                if section == "model_bounds" and isinstance(e["value"], int):
+                    pml.append(f"#define {pid.upper()} {e['value']}")
+            if ns:
+                lines.append(f"}}  // namespace {ns}")
+        lines.append(f"}}  // namespace railproof::params::{name}")
+        _write_if_changed(Path(out_dir) / "include/railproof/generated" / f"{name}_params.hpp",
+                          "\n".join(lines) + "\n")
+        _write_if_changed(Path(out_dir) / "models" / f"{name}_params.pml", "\n".join(pml) + "\n")
+
+
+def register(sub):
+    p = sub.add_parser("gen-params", help="validate spec/ and generate parameter headers")
+    p.add_argument("--spec", required=True, help="spec/ directory")
+    p.add_argument("--out", required=True, help="output directory (build/gen)")
+    p.set_defaults(func=lambda a: generate(Path(a.spec), Path(a.out)))

@@ -1,0 +1,379 @@
+"""Specification checker: JSON-Schema validation of spec/ plus semantic cross-checks.
+
+Command ``validate --spec DIR`` checks every YAML file of
+``spec/{requirements,hazards,assumptions,parameters,justifications}`` against the
+Draft 2020-12 schemas in ``spec/schemas/``, then the cross-references the schemas cannot
+express. It collects every finding, prints each as one line ``file: entry: reason`` and
+exits 1 if there is any error (warnings alone do not fail).
+
+Rules checked after the schema:
+- IDs are unique within and across files (requirements, hazards, assumptions,
+  justifications; parameter ids within a file, both sections together), and a
+  requirement's ``REQ-<AREA>-NNN`` area is the file's ``area``;
+- no two parameter files declare the same area (their generated headers would collide);
+- a requirement with SIL >= 3 is not verified by ``review`` alone;
+- every ``REQ-…``, ``HAZ-…``, ``ASM-…`` or ``UR-…`` token in any string of any entry
+  (``hazards``, ``source``, parameter ``requirements``, text, rationale) names an existing
+  entry; a token that looks like an ID but is malformed is an error too;
+- every hazard is addressed by at least one requirement.  This is an error, not a warning:
+  an unaddressed hazard is an open item in the hazard log, and the safety case cannot be
+  closed over it; the fix is either a requirement that mitigates it or removing the hazard
+  with a recorded reason;
+- every requirement ``source`` entry and every parameter ``source`` cites D1-D5 with a
+  section (``D5 §6.4``, ``D1 chapter 3``), an assumption ``ASM-NNN`` or a named standard
+  (``EN 50159``, ``IEC 62280``, ``RFC 8439``...).
+
+Warnings: an assumption that nothing references; a SIL >= 3 requirement naming no hazard.
+"""
+from __future__ import annotations
+
+import json
+import re
+import sys
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import jsonschema
+
+from . import spec as spec_mod
+from .errors import SpecError
+
+AREAS = ("TG", "MB", "BR", "SC", "RA", "LC", "GN", "FC", "AV")
+METHODS = ("model", "vectors", "unit", "analysis", "proof", "review")
+_AREA_RE = "|".join(AREAS)
+REQ_ID = re.compile(rf"^REQ-({_AREA_RE})-\d{{3}}$")
+HAZ_ID = re.compile(r"^HAZ-\d{3}$")
+ASM_ID = re.compile(r"^ASM-\d{3}$")
+UR_ID = re.compile(rf"^UR-({_AREA_RE})-\d{{3}}$")
+
+# Anything that looks like an identifier of ours inside free text.
+ID_TOKEN = re.compile(r"\b(?:REQ|HAZ|ASM|UR)-[A-Za-z0-9]+(?:-[A-Za-z0-9]+)*")
+
+# A source citation: D1-D5 with a section or chapter, an assumption, or a named standard.
+CITATION = re.compile(
+    r"\bD[1-5]\s*(?:§\s*\d|chapters?\s+\d)"
+    r"|\bASM-\d{3}\b"
+    r"|\b(?:EN|IEC|ISO|IEEE|UIC|DIN|RFC|FIPS|CLC/TS|CLC/TR|ISO/IEC|NIST\s+SP)\s*[-:]?\s*\d"
+    r"|\bMISRA\b")
+
+# kind -> (sub-directory of spec/, list key, schema file, id pattern)
+KINDS = {
+    "requirements": ("requirements", "requirements", "requirements.schema.json", REQ_ID),
+    "hazards": ("hazards", "hazards", "hazards.schema.json", HAZ_ID),
+    "assumptions": ("assumptions", "assumptions", "assumptions.schema.json", ASM_ID),
+    "justifications": ("justifications", "justifications", "justifications.schema.json", UR_ID),
+    "parameters": ("parameters", None, "parameters.schema.json", None),
+}
+_PREFIX_KIND = {"REQ": "requirements", "HAZ": "hazards", "ASM": "assumptions",
+                "UR": "justifications"}
+_KIND_WORD = {"requirements": "requirement", "hazards": "hazard",
+              "assumptions": "assumption", "justifications": "justification"}
+
+
+@dataclass(frozen=True, order=True)
+class Finding:
+    """One reported problem: ``file: entry: reason``."""
+
+    file: str
+    entry: str
+    reason: str
+
+    def __str__(self):
+        return f"{self.file}: {self.entry}: {self.reason}"
+
+
+@dataclass
+class Report:
+    """Collects errors and warnings; nothing stops at the first finding."""
+
+    errors: list = field(default_factory=list)
+    warnings: list = field(default_factory=list)
+
+    def error(self, file, entry, reason):
+        f = Finding(str(file), str(entry), str(reason))
+        if f not in self.errors:
+            self.errors.append(f)
+        return f
+
+    def warn(self, file, entry, reason):
+        f = Finding(str(file), str(entry), str(reason))
+        if f not in self.warnings:
+            self.warnings.append(f)
+        return f
+
+    def print(self, stream=None):
+        stream = stream or sys.stderr
+        for w in self.warnings:
+            print(f"warning: {w}", file=stream)
+        for e in self.errors:
+            print(e, file=stream)
+
+
+_VALIDATORS = {}  # schema text -> validator (checking a schema against the meta-schema is slow)
+
+
+def _load_schema(spec_dir: Path, name: str):
+    path = Path(spec_dir) / "schemas" / name
+    try:
+        text = path.read_text(encoding="utf-8")
+        if text in _VALIDATORS:
+            return _VALIDATORS[text]
+        schema = json.loads(text)
+    except FileNotFoundError:
+        raise SpecError(path, "-", "schema file not found") from None
+    except json.JSONDecodeError as exc:
+        raise SpecError(path, f"line {exc.lineno}", f"malformed JSON: {exc.msg}") from None
+    try:
+        jsonschema.Draft202012Validator.check_schema(schema)
+    except jsonschema.SchemaError as exc:
+        raise SpecError(path, "/".join(map(str, exc.path)) or "-",
+                        f"invalid schema: {exc.message}") from None
+    _VALIDATORS[text] = jsonschema.Draft202012Validator(schema)
+    return _VALIDATORS[text]
+
+
+def _entry_name(data, path):
+    """Human name of the entry a schema error points at: its id if it has one."""
+    if not path:
+        return "-", ""
+    head = path[0]
+    if len(path) >= 2 and isinstance(path[1], int):
+        lst = data.get(head) if isinstance(data, dict) else None
+        item = lst[path[1]] if isinstance(lst, list) and path[1] < len(lst) else None
+        name = item.get("id") if isinstance(item, dict) else None
+        name = name if isinstance(name, str) and name else f"{head}[{path[1]}]"
+        rest = ".".join(str(p) if not isinstance(p, int) else f"[{p}]" for p in path[2:])
+        return name, rest.replace(".[", "[")
+    return str(head), ".".join(str(p) for p in path[1:])
+
+
+def _schema_errors(validator, data, file, report):
+    n = 0
+    for err in sorted(validator.iter_errors(data), key=lambda e: [str(p) for p in e.path]):
+        entry, where = _entry_name(data, list(err.path))
+        report.error(file, entry, f"{where}: {err.message}" if where else err.message)
+        n += 1
+    return n
+
+
+def _strings(obj, where=""):
+    """Yield (field path, string) for every string inside obj."""
+    if isinstance(obj, str):
+        yield where, obj
+    elif isinstance(obj, dict):
+        for k, v in obj.items():
+            yield from _strings(v, f"{where}.{k}" if where else str(k))
+    elif isinstance(obj, list):
+        for i, v in enumerate(obj):
+            yield from _strings(v, f"{where}[{i}]")
+
+
+def _id_pattern(token):
+    prefix = token.split("-", 1)[0]
+    return _PREFIX_KIND[prefix], {"REQ": REQ_ID, "HAZ": HAZ_ID, "ASM": ASM_ID, "UR": UR_ID}[prefix]
+
+
+def _list_files(spec_dir: Path, sub: str, report: Report):
+    for bad in sorted((Path(spec_dir) / sub).glob("*.yml")):
+        report.error(bad, "-", "use the .yaml extension (files named *.yml are not read)")
+    return spec_mod.spec_files(spec_dir, sub)
+
+
+def check_spec(spec_dir):
+    """Check spec_dir completely. Returns (model, report); model is built from the
+    entries that could be read even when the report has errors."""
+    spec_dir = Path(spec_dir)
+    report = Report()
+    if not spec_dir.is_dir():
+        report.error(spec_dir, "-", "spec directory not found")
+        return _empty_model(), report
+    model = _empty_model()
+    origin = {}  # id -> file, for duplicate messages
+    refs = []  # (file, entry id, field, token) for the cross-reference pass
+    param_areas = {}
+
+    for kind, (sub, key, schema_name, id_re) in KINDS.items():
+        try:
+            validator = _load_schema(spec_dir, schema_name)
+        except SpecError as exc:
+            report.error(exc.file, exc.entry, exc.reason)
+            continue
+        files = _list_files(spec_dir, sub, report)
+        if not files and kind in ("requirements", "hazards", "parameters"):
+            report.error(spec_dir / sub, "-", f"no {kind} files (*.yaml)")
+        for f in files:
+            try:
+                data = spec_mod.load_yaml(f)
+            except SpecError as exc:
+                report.error(exc.file, exc.entry, exc.reason)
+                continue
+            _schema_errors(validator, data, f, report)
+            if kind == "parameters":
+                _collect_parameters(f, data, model, param_areas, refs, report)
+                continue
+            area = data.get("area") if isinstance(data.get("area"), str) else None
+            entries = data.get(key)
+            if not isinstance(entries, list):
+                continue
+            for i, e in enumerate(entries):
+                if not isinstance(e, dict) or not isinstance(e.get("id"), str):
+                    continue  # already reported by the schema
+                eid = e["id"]
+                if not id_re.match(eid):
+                    continue  # reported by the schema (pattern)
+                if eid in origin:
+                    report.error(f, eid, f"duplicate id (first defined in {origin[eid]})")
+                    continue
+                origin[eid] = f
+                if kind == "requirements" and area and eid.split("-")[1] != area:
+                    report.error(f, eid, f"id area {eid.split('-')[1]} does not match the "
+                                         f"file's area {area}")
+                entry = dict(e)
+                entry["file"] = str(f)
+                if kind == "requirements":
+                    entry["area"] = eid.split("-")[1]
+                model[kind][eid] = entry
+                for where, s in _strings({k: v for k, v in e.items() if k != "id"}):
+                    refs.append((f, eid, where, s))
+
+    _check_references(model, refs, report)
+    _check_requirements(model, report)
+    _check_hazards_addressed(model, report)
+    _check_assumptions_used(model, refs, report)
+    return model, report
+
+
+def _empty_model():
+    return {"requirements": {}, "hazards": {}, "assumptions": {}, "justifications": {},
+            "parameters": {}}
+
+
+def _collect_parameters(f, data, model, param_areas, refs, report):
+    area = data.get("area")
+    if isinstance(area, str):
+        if area in param_areas:
+            report.error(f, "area", f"area {area} is also declared by {param_areas[area]}; "
+                                    "one parameter file per area")
+            return
+        param_areas[area] = f
+    else:
+        area = None
+    out = {"file": f, "parameters": {}, "model_bounds": {}}
+    seen = {}
+    for section in ("parameters", "model_bounds"):
+        entries = data.get(section)
+        if not isinstance(entries, list):
+            continue
+        for e in entries:
+            if not isinstance(e, dict) or not isinstance(e.get("id"), str):
+                continue
+            pid = e["id"]
+            if pid in seen:
+                report.error(f, pid, f"duplicate parameter id (also in {seen[pid]})")
+                continue
+            seen[pid] = section
+            v = e.get("value")
+            if isinstance(v, bool) or not isinstance(v, (int, float)):
+                continue  # reported by the schema
+            out[section][pid] = e
+            if section == "parameters" and isinstance(e.get("source"), str) \
+                    and not CITATION.search(e["source"]):
+                report.error(f, pid, f"source {e['source']!r} cites no D1-D5 section, "
+                                     "ASM-NNN or named standard")
+            for where, s in _strings({k: v for k, v in e.items() if k != "id"}):
+                refs.append((f, pid, where, s))
+    if area:
+        model["parameters"][area] = out
+
+
+def _check_references(model, refs, report):
+    for f, eid, where, s in refs:
+        for token in ID_TOKEN.findall(s):
+            kind, pattern = _id_pattern(token)
+            if not pattern.match(token):
+                report.error(f, eid, f"{where}: malformed reference {token!r}")
+            elif token not in model[kind]:
+                report.error(f, eid, f"{where}: unknown {_KIND_WORD[kind]} {token}")
+
+
+def _check_requirements(model, report):
+    for rid, r in sorted(model["requirements"].items()):
+        f = r["file"]
+        sil = r.get("sil")
+        ver = r.get("verification")
+        if isinstance(sil, int) and not isinstance(sil, bool) and sil >= 3 \
+                and isinstance(ver, list) and set(ver) == {"review"}:
+            report.error(f, rid, f"SIL {sil} requirement verified by review alone; "
+                                 "add model, vectors, unit, analysis or proof")
+        src = r.get("source")
+        if isinstance(src, list):
+            for i, s in enumerate(src):
+                if isinstance(s, str) and not CITATION.search(s):
+                    report.error(f, rid, f"source[{i}] {s!r} cites no D1-D5 section, "
+                                         "ASM-NNN or named standard")
+        if isinstance(sil, int) and sil >= 3 and r.get("hazards") == []:
+            report.warn(f, rid, f"SIL {sil} requirement names no hazard")
+
+
+def _check_hazards_addressed(model, report):
+    addressed = set()
+    for r in model["requirements"].values():
+        if isinstance(r.get("hazards"), list):
+            addressed.update(h for h in r["hazards"] if isinstance(h, str))
+    for hid, h in sorted(model["hazards"].items()):
+        if hid not in addressed:
+            report.error(h["file"], hid, "hazard is not addressed by any requirement")
+
+
+def _check_assumptions_used(model, refs, report):
+    used = set()
+    for _f, eid, _where, s in refs:
+        used.update(t for t in ID_TOKEN.findall(s) if t.startswith("ASM-") and t != eid)
+    for aid, a in sorted(model["assumptions"].items()):
+        if aid not in used:
+            report.warn(a["file"], aid, "assumption is not referenced by any requirement, "
+                                        "hazard, parameter or other assumption")
+
+
+def validate_spec(spec_dir):
+    """Validate spec_dir and return the loaded model::
+
+        {"requirements": {id: entry + {"file", "area"}},
+         "hazards": {id: entry + {"file"}}, "assumptions": {...}, "justifications": {...},
+         "parameters": {area: {"file": Path, "parameters": {id: entry},
+                               "model_bounds": {id: entry}}}}
+
+    Raises SpecError naming the first error, with "(and N more)" if there are more.
+    """
+    model, report = check_spec(spec_dir)
+    if report.errors:
+        first = report.errors[0]
+        more = len(report.errors) - 1
+        raise SpecError(first.file, first.entry,
+                        first.reason + (f" (and {more} more)" if more else ""))
+    return model
+
+
+def run(args):
+    model, report = check_spec(Path(args.spec))
+    report.print()
+    n = {k: len(v) for k, v in model.items()}
+    if report.errors:
+        print(f"validate: {len(report.errors)} error(s), {len(report.warnings)} warning(s) "
+              f"in {args.spec}", file=sys.stderr)
+        return 1
+    print(f"validate: {args.spec} ok: {n['requirements']} requirements, {n['hazards']} hazards, "
+          f"{n['assumptions']} assumptions, {n['parameters']} parameter file(s), "
+          f"{n['justifications']} justifications; {len(report.warnings)} warning(s)")
+    return 0
+
+
+def register(sub):
+    p = sub.add_parser(
+        "validate", help="check spec/ against its JSON schemas and cross-references",
+        description="Validate every YAML file of spec/{requirements,hazards,assumptions,"
+                    "parameters,justifications} against spec/schemas and check IDs and "
+                    "references. Prints every finding as 'file: entry: reason'; exit 1 on "
+                    "any error.")
+    p.add_argument("--spec", required=True, help="spec/ directory")
+    p.set_defaults(func=run)
