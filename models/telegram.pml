@@ -1,8 +1,8 @@
 /*
  * railproof — radio telegram safety layer (D5 §6.3, §6.4; EN 50159 defences).
  *
- * What is modelled. One endpoint R (the ground control unit with -DROLE=0, the on-board
- * unit with -DROLE=1) runs the receiver checks of spec/design/telegram-layer.md §4 in the
+ * What is modelled. One endpoint R (the ground control unit or the on-board unit: their
+ * logic is identical, only their outputs' names differ) runs the receiver checks of spec/design/telegram-layer.md §4 in the
  * same order as cpp/src/radio/endpoint.cpp, its link supervision (§5) and its sending
  * rule (§5, REQ-TG-008/-012). Its peer is abstracted to the peer's guarantee (below).
  * Between them a channel loses, duplicates, re-orders, delays and corrupts telegrams, and
@@ -31,13 +31,10 @@
  * Annotations read by testgen:
  *   // @property <ltl name> <REQ ids> : text
  *   // @goal <K> <REQ ids> : label          (coverage goal K, trap property [] !g[K])
- *   // @mutant <NAME> violates <ltl name> : text
+ *   // @mutant <NAME> violates <ltl name> | assert:<label> : text
+ *   // @assert <label> <REQ ids> : text     (on the line before an assert(...))
  */
 #include "telegram_params.pml"
-
-#ifndef ROLE
-#define ROLE 1
-#endif
 
 #ifdef MUTANT_SEQ_WIDTH_8
 #define M 8
@@ -52,15 +49,17 @@
 #define A_MAX MODEL_MAX_DELAY_TICKS
 #define CAP MODEL_CHANNEL_CAPACITY
 #define E_MAX (A_MAX + T_ECHO)
+/* TICKS below enumerates echo ages 0..5: keep E_MAX == 5 or extend the list */
 #define NONE 255
 
-#if ROLE == 0
-#define INIT_OWN MODEL_INIT_GROUND_SEQ
-#define INIT_PEER MODEL_INIT_TRAIN_SEQ
+#define INIT_OWN MODEL_INIT_OWN_SEQ
+#define INIT_PEER MODEL_INIT_PEER_SEQ
+#ifdef MUTANT_ECHO_NEVER_EXPIRES
+#define PEER_AGE_CAP (E_MAX + 1)   /* the mutant needs the true age beyond T_ECHO */
 #else
-#define INIT_OWN MODEL_INIT_TRAIN_SEQ
-#define INIT_PEER MODEL_INIT_GROUND_SEQ
+#define PEER_AGE_CAP (T_ECHO + 1)
 #endif
+#define STALEPEER 254   /* peer number known but expired: no decision reads it (below) */
 
 #define L_NONE 0
 #define L_UP 1
@@ -99,11 +98,11 @@ Msg q[CAP];     /* telegrams in flight towards R */
 byte next;        /* next own sequence number */
 byte sent;        /* own telegrams sent, saturating at H */
 byte peer;        /* last in-sequence peer sequence number, NONE before the first */
-byte peer_age;    /* ticks since peer was updated, saturating at T_ECHO + 1 */
+byte peer_age;    /* ticks since peer was updated, saturating at PEER_AGE_CAP */
 byte since;       /* ticks since the last acceptance, saturating at T_LINK + 1 */
 byte link;
-bit eb;           /* on-board output (ROLE 1): emergency brake demand */
-bit abnormal;     /* ground output (ROLE 0): train tracking abnormal */
+bit eb = 1;       /* on-board output: emergency brake demand */
+bit abnormal = 1; /* ground output: train tracking abnormal */
 byte peer_rx_age_g;  /* ghost: age at receipt of the telegram that set peer */
 byte last_acc_g;     /* ghost: true send age of the last accepted telegram, capped */
 
@@ -130,6 +129,36 @@ byte gi;
 #endif
 
 #define SCRATCH_RESET echo_out = 0; slot = 0; dd = 0; k = 0; verdict = 0; gap = 0; ea = 0
+
+/* Symmetry reduction: the channel is a set (any slot may be delivered next), so the two
+   slots are kept in a canonical order after every step: occupied before free, older
+   before younger, then by echo and ghost age. Slot positions are never observable. */
+Msg tmp;
+#define SWAP_SLOTS tmp.busy = q[0].busy; tmp.seq = q[0].seq; tmp.echo = q[0].echo; \
+  tmp.age = q[0].age; tmp.eage_g = q[0].eage_g; \
+  q[0].busy = q[1].busy; q[0].seq = q[1].seq; q[0].echo = q[1].echo; \
+  q[0].age = q[1].age; q[0].eage_g = q[1].eage_g; \
+  q[1].busy = tmp.busy; q[1].seq = tmp.seq; q[1].echo = tmp.echo; \
+  q[1].age = tmp.age; q[1].eage_g = tmp.eage_g; \
+  tmp.busy = 0; tmp.seq = 0; tmp.echo = 0; tmp.age = 0; tmp.eage_g = 0
+inline canonical() {
+  if
+  :: !q[0].busy && q[1].busy -> SWAP_SLOTS
+  :: q[0].busy && q[1].busy &&
+     (q[0].age < q[1].age ||
+      (q[0].age == q[1].age && (q[0].echo < q[1].echo ||
+        (q[0].echo == q[1].echo && q[0].eage_g < q[1].eage_g)))) -> SWAP_SLOTS
+  :: else -> skip
+  fi;
+  if
+  :: !q[1].busy -> q[1].seq = 0; q[1].echo = 0; q[1].age = 0; q[1].eage_g = 0
+  :: else -> skip
+  fi;
+  if
+  :: !q[0].busy -> q[0].seq = 0; q[0].echo = 0; q[0].age = 0; q[0].eage_g = 0
+  :: else -> skip
+  fi
+}
 
 /* outputs derived from the link state (REQ-TG-014, REQ-TG-015) */
 inline outputs() {
@@ -160,8 +189,18 @@ inline age_channel() {
 
 inline supervise() {
   SAT(since, T_LINK + 1);
-  SAT(peer_age, T_ECHO + 1);
+  SAT(peer_age, PEER_AGE_CAP);
   SAT(last_acc_g, A_MAX + 1);
+  /* Dead-value reduction: once the echo has expired the peer number is read by no
+     decision (the sequence check runs only while UP, and UP implies peer_age <= since
+     <= T_LINK <= T_ECHO), so its value is forgotten to keep the state space small. The
+     C++ keeps the number; no output differs. */
+#ifndef MUTANT_ECHO_NEVER_EXPIRES
+  if
+  :: peer != NONE && peer_age > T_ECHO -> peer = STALEPEER
+  :: else -> skip
+  fi;
+#endif
   if
 #ifndef MUTANT_NO_LINK_TIMEOUT
   :: link == L_UP && since > T_LINK -> link = L_LOST; GOAL(16)     /* link lost */
@@ -178,13 +217,14 @@ inline supervise() {
 inline r_send() {
   if
 #ifdef MUTANT_ECHO_NEVER_EXPIRES
-  :: peer != NONE -> echo_out = peer
+  :: peer < M -> echo_out = peer
 #else
   :: peer != NONE && peer_age <= T_ECHO -> echo_out = peer
 #endif
   :: else -> echo_out = NONE
   fi;
-  /* R_GUARANTEE_ECHO_AGE: what R echoes was sent at most E_MAX ticks ago */
+  /* R's guarantee PG2: what R echoes was sent at most E_MAX ticks ago */
+  // @assert R_GUARANTEE_ECHO_AGE REQ-TG-012 : R echoes only numbers sent at most E_MAX ticks ago (PG2)
   assert(echo_out == NONE || peer_rx_age_g + peer_age <= E_MAX);
   printf("@OUT tx seq=%d echo=%d link=%d eb=%d abnormal=%d\n", next, echo_out, link, eb, abnormal);
   if
@@ -231,6 +271,7 @@ inline tick() {
   SAT(boot, E_MAX + 1);
   r_send();
   p_send();
+  canonical();
   SCRATCH_RESET
 }
 
@@ -253,6 +294,8 @@ inline receive(s, mode) {
      verdict = V_ACCEPT;
      if
      :: link == L_UP ->                                          /* CheckSequenceNumber */
+        // @assert LIVE_PEER_WHEN_UP REQ-TG-004 : the sequence check never reads a forgotten peer number
+        assert(peer < M);
         dd = (q[s].seq + M - peer) % M;
         if
 #ifndef MUTANT_NO_REPEAT_CHECK
@@ -268,7 +311,7 @@ inline receive(s, mode) {
      if
      :: verdict == V_ACCEPT ->
         if
-        :: peer != NONE && q[s].seq < peer -> GOAL(13)          /* peer number wrapped */
+        :: peer < M && q[s].seq < peer -> GOAL(13)          /* peer number wrapped */
         :: else -> skip
         fi;
         peer = q[s].seq;                                         /* in sequence (REQ-TG-012) */
@@ -335,6 +378,7 @@ inline receive(s, mode) {
   :: mode == D_INTACT || mode == D_CORRUPT -> q[s].busy = 0
   :: else -> skip
   fi;
+  canonical();
   SCRATCH_RESET
 }
 
@@ -348,29 +392,35 @@ inline init_state() {
   outputs()
 }
 
+/* One do-option per choice of the peer's echo (PG2), each a single d_step, so that no
+   intermediate states are stored. TICK(a): the peer echoes R's telegram of age a
+   (NONE: no echo); only telegrams R has actually sent can be named (a <= boot). */
+#define TICK(a) :: CAN_TICK && (a == NONE || a <= boot) -> d_step { ea = a; tick() }
+
 #ifdef HEALTHY
 /* REQ-TG-016: every telegram is delivered intact within the tick it was sent in, and the
    peer echoes R's telegram of the previous tick (a perfect round trip). */
 #define CAN_TICK (!q[0].busy && !q[1].busy)
-#define PEER_ECHO :: boot == 0 -> ea = NONE :: boot > 0 -> ea = 1
+#define TICKS \
+  :: CAN_TICK && boot == 0 -> d_step { ea = NONE; tick() } \
+  :: CAN_TICK && boot > 0 -> d_step { ea = 1; tick() }
 #define DELIVER(S) :: q[S].busy -> d_step { receive(S, D_INTACT) }
 #else
 #define CAN_TICK true
-/* PG2: no echo, or any of R's telegrams sent 0..E_MAX ticks ago (and actually sent) */
-#define PEER_ECHO :: ea = NONE :: select(ea : 0 .. E_MAX); if :: ea > boot -> ea = boot :: else -> skip fi
+#define TICKS TICK(NONE) TICK(0) TICK(1) TICK(2) TICK(3) TICK(4) TICK(5)
 #define DELIVER(S) \
   :: q[S].busy -> d_step { receive(S, D_INTACT) } \
   :: q[S].busy -> d_step { receive(S, D_DUP) } \
   :: q[S].busy -> d_step { receive(S, D_CORRUPT) } \
   :: q[S].busy -> d_step { receive(S, D_FORGE) } \
   :: q[S].busy -> d_step { receive(S, D_MISADDR) } \
-  :: q[S].busy -> d_step { CLEAR_GOALS; q[S].busy = 0 }
+  :: q[S].busy -> d_step { CLEAR_GOALS; q[S].busy = 0; canonical() }
 #endif
 
 active proctype env() {
   d_step { init_state() };
   do
-  :: CAN_TICK -> atomic { if PEER_ECHO fi; d_step { tick() } }
+  TICKS
   DELIVER(0)
   DELIVER(1)
   od

@@ -1,0 +1,313 @@
+"""Run SPIN: exhaustive verification of every named property, and the mutant models.
+
+`verify` compiles the model once per configuration (pan with -DBFS -DSAFETY: a complete
+breadth-first search; for safety properties it is exhaustive and needs no depth bound),
+runs `./pan -N <property>` for every `// @property`, then compiles and runs every
+`// @mutant`, which must be rejected. Any violated or incomplete property fails the
+command with the counterexample shown; so does a surviving mutant.
+"""
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import re
+import shutil
+import subprocess
+import sys
+import time
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from .errors import PipelineError, SpecError
+
+_REQ = re.compile(r"REQ-[A-Z]{2}-\d{3}")
+_PROP = re.compile(r"^\s*//\s*@property\s+(\w+)\s+((?:REQ-[A-Z]{2}-\d{3}\s*)+):\s*(.*)$")
+_GOAL = re.compile(r"^\s*//\s*@goal\s+(\d+)\s+((?:REQ-[A-Z]{2}-\d{3}\s*)+):\s*(.*)$")
+_MUT = re.compile(r"^\s*//\s*@mutant\s+(\w+)\s+violates\s+(\S+)\s*:\s*(.*)$")
+_ASSERT = re.compile(r"^\s*//\s*@assert\s+(\w+)\s+((?:REQ-[A-Z]{2}-\d{3}\s*)+):\s*(.*)$")
+_CONFIG = re.compile(r"\[config\s+(\w+)\]")
+
+PAN_FLAGS = ["-O2", "-DSAFETY", "-DBFS", "-DMEMLIM=8000"]
+
+
+@dataclass
+class Property:
+    name: str
+    requirements: list
+    text: str
+    config: str | None  # -D symbol of the configuration, None = default
+
+
+@dataclass
+class Goal:
+    number: int
+    requirements: list
+    label: str
+
+    @property
+    def gid(self):
+        return f"G{self.number}"
+
+
+@dataclass
+class Mutant:
+    name: str
+    violates: str  # property name or "assert:<label>"
+    text: str
+
+
+@dataclass
+class Annotations:
+    model: Path
+    properties: list = field(default_factory=list)
+    goals: list = field(default_factory=list)
+    mutants: list = field(default_factory=list)
+    asserts: dict = field(default_factory=dict)  # label -> (expression without spaces, requirements, text)
+
+
+def _squash(expr: str) -> frozenset:
+    """Identify an assertion by its variables (pan prints it with macros expanded)."""
+    return frozenset(re.findall(r"\b[a-z_][a-z0-9_]*\b", expr))
+
+
+def parse_annotations(model: Path) -> Annotations:
+    model = Path(model)
+    ann = Annotations(model)
+    seen = set()
+    lines = model.read_text(encoding="utf-8").splitlines()
+    for lineno, line in enumerate(lines, 1):
+        m = _ASSERT.match(line)
+        if m:
+            nxt = lines[lineno] if lineno < len(lines) else ""
+            am = re.match(r"^\s*assert\((.*)\);?\s*$", nxt)
+            if not am:
+                raise SpecError(model, f"line {lineno}", "@assert must be followed by an assert(...) line")
+            ann.asserts[m.group(1)] = (_squash(am.group(1)), _REQ.findall(m.group(2)), m.group(3).strip())
+            continue
+        for rx, kind in ((_PROP, "property"), (_GOAL, "goal"), (_MUT, "mutant")):
+            m = rx.match(line)
+            if not m:
+                continue
+            key = (kind, m.group(1))
+            if key in seen:
+                raise SpecError(model, f"line {lineno}", f"duplicate @{kind} {m.group(1)}")
+            seen.add(key)
+            if kind == "property":
+                cfg = _CONFIG.search(m.group(3))
+                ann.properties.append(Property(m.group(1), _REQ.findall(m.group(2)), m.group(3).strip(),
+                                               cfg.group(1) if cfg else None))
+            elif kind == "goal":
+                ann.goals.append(Goal(int(m.group(1)), _REQ.findall(m.group(2)), m.group(3).strip()))
+            else:
+                ann.mutants.append(Mutant(m.group(1), m.group(2), m.group(3).strip()))
+    if not ann.properties:
+        raise SpecError(model, "-", "no // @property annotations")
+    names = {p.name for p in ann.properties}
+    for mu in ann.mutants:
+        if mu.violates.startswith("assert:"):
+            if mu.violates[7:] not in ann.asserts:
+                raise SpecError(model, mu.name, f"mutant names unknown assertion {mu.violates}")
+        elif mu.violates not in names:
+            raise SpecError(model, mu.name, f"mutant names unknown property {mu.violates}")
+    return ann
+
+
+def sha256_file(path: Path) -> str:
+    return hashlib.sha256(Path(path).read_bytes()).hexdigest()
+
+
+def spin_version() -> str:
+    try:
+        out = subprocess.run(["spin", "-V"], capture_output=True, text=True, check=False).stdout
+    except FileNotFoundError:
+        raise PipelineError("spin not found on PATH (install the Debian package 'spin')") from None
+    return out.strip()
+
+
+def read_bounds(params_pml: Path) -> dict:
+    bounds = {}
+    for line in Path(params_pml).read_text(encoding="utf-8").splitlines():
+        m = re.match(r"#define\s+MODEL_(\w+)\s+(-?\d+)", line)
+        if m:
+            bounds[m.group(1).lower()] = int(m.group(2))
+    return bounds
+
+
+def _run(cmd, cwd, timeout=None):
+    return subprocess.run(cmd, cwd=cwd, capture_output=True, text=True, timeout=timeout, check=False)
+
+
+def prepare(model: Path, params_dir: Path, workdir: Path, defines=(), extra_files=()):
+    """Copy the model and its generated includes into workdir, run spin -a, compile pan."""
+    workdir = Path(workdir)
+    if workdir.exists():
+        shutil.rmtree(workdir)
+    workdir.mkdir(parents=True)
+    shutil.copy2(model, workdir / Path(model).name)
+    for inc in Path(params_dir).glob("*.pml"):
+        shutil.copy2(inc, workdir / inc.name)
+    for f in extra_files:
+        shutil.copy2(f, workdir / Path(f).name)
+    dflags = [f"-D{d}" for d in defines]
+    r = _run(["spin", *dflags, "-a", Path(model).name], workdir)
+    if r.returncode != 0 or not (workdir / "pan.c").exists():
+        raise PipelineError(f"spin -a {' '.join(dflags)} {model} failed:\n{r.stdout}{r.stderr}")
+    r = _run(["cc", *PAN_FLAGS, "-o", "pan", "pan.c"], workdir)
+    if r.returncode != 0:
+        raise PipelineError(f"compiling pan for {model} {' '.join(dflags)} failed:\n{r.stderr[-4000:]}")
+    return workdir
+
+
+_NUM = r"([0-9.e+]+)"
+
+
+def parse_pan(out: str) -> dict:
+    def grab(rx, conv=float, default=None):
+        m = re.search(rx, out)
+        return conv(m.group(1)) if m else default
+
+    res = {
+        "errors": grab(r"errors:\s*(\d+)", int),
+        "states_stored": grab(rx=r"\n\s*" + _NUM + r" states, stored", conv=lambda s: int(float(s))),
+        "states_matched": grab(r"\n\s*" + _NUM + r" states, matched", lambda s: int(float(s))),
+        "transitions": grab(r"\n\s*" + _NUM + r" transitions", lambda s: int(float(s))),
+        "depth": grab(r"depth reached (\d+)", int),
+        "state_vector_bytes": grab(r"State-vector (\d+) byte", int),
+        "memory_mb": grab(r"([0-9.]+)\s+total actual memory usage"),
+        "time_s": grab(r"pan: elapsed time ([0-9.e+]+)"),
+    }
+    incomplete = []
+    if "max search depth too small" in out:
+        incomplete.append("search depth bound reached")
+    if "out of memory" in out.lower() or "pan: reached -DMEMLIM" in out:
+        incomplete.append("out of memory")
+    if "Full statespace search" not in out and res["errors"] == 0:
+        incomplete.append("no full state-space search reported")
+    res["incomplete"] = incomplete
+    m = re.search(r"assertion violated (.*?) \(at depth", out)
+    res["violated_expression"] = _squash(m.group(1)) if m else None
+    return res
+
+
+def counterexample(workdir: Path, model_name: str, defines=()) -> str:
+    """Replay the trail and return the @IN/@OUT lines (and the last raw lines)."""
+    dflags = [f"-D{d}" for d in defines]
+    r = _run(["spin", *dflags, "-t", model_name], workdir, timeout=120)
+    lines = [ln.strip() for ln in r.stdout.splitlines() if "@IN" in ln or "@OUT" in ln]
+    tail = [ln for ln in r.stdout.splitlines() if ln.strip()][-6:]
+    return "\n".join(lines + ["..."] + tail)
+
+
+def _progress(msg):
+    print(f"spin: {msg}", flush=True)
+
+
+def verify(model: Path, params_dir: Path, workdir: Path, out_json: Path, jobs: int = 2) -> dict:
+    model = Path(model)
+    ann = parse_annotations(model)
+    version = spin_version()
+    bounds = read_bounds(next(Path(params_dir).glob(f"{model.stem}_params.pml")))
+    configs = sorted({p.config for p in ann.properties}, key=lambda c: c or "")
+    t0 = time.monotonic()
+    dirs = {}
+    for cfg in configs:
+        name = cfg or "default"
+        _progress(f"compiling {model.name} [{name}]")
+        dirs[cfg] = prepare(model, params_dir, Path(workdir) / f"verify-{name}", [cfg] if cfg else [])
+
+    def run_prop(p: Property):
+        # each property in its own copy of the binary's directory: pan writes the trail there
+        wd = Path(workdir) / f"prop-{p.name}"
+        if wd.exists():
+            shutil.rmtree(wd)
+        shutil.copytree(dirs[p.config], wd)
+        r = _run(["./pan", "-N", p.name], wd)
+        res = parse_pan(r.stdout + r.stderr)
+        if res["errors"] is None:
+            raise PipelineError(f"{model.name}: pan -N {p.name}: unexpected output:\n{r.stdout[-2000:]}{r.stderr[-2000:]}")
+        verdict = "verified"
+        cex = None
+        if res["errors"]:
+            verdict = "violated"
+            cex = counterexample(wd, model.name, [p.config] if p.config else [])
+        elif res["incomplete"]:
+            verdict = "incomplete"
+        _progress(f"{p.name}: {verdict} ({res['states_stored']} states, depth {res['depth']}, {res['time_s']} s)")
+        return {"name": p.name, "requirements": p.requirements, "text": p.text,
+                "configuration": p.config or "default", "verdict": verdict,
+                "command": f"spin {'-D' + p.config + ' ' if p.config else ''}-a {model.name} && "
+                           f"cc {' '.join(PAN_FLAGS)} -o pan pan.c && ./pan -N {p.name}",
+                "counterexample": cex, **{k: v for k, v in res.items() if k != "violated_expression"}}
+
+    _progress(f"verifying {len(ann.properties)} properties with {jobs} job(s)")
+    with ThreadPoolExecutor(max_workers=max(1, jobs)) as ex:
+        props = list(ex.map(run_prop, ann.properties))
+
+    def run_mutant(mu: Mutant):
+        wd = prepare(model, params_dir, Path(workdir) / f"mutant-{mu.name}", [mu.name])
+        claim = mu.violates if not mu.violates.startswith("assert:") else ann.properties[0].name
+        r = _run(["./pan", "-N", claim], wd)
+        res = parse_pan(r.stdout + r.stderr)
+        model_asserts = {expr for expr, _, _ in ann.asserts.values()}
+        violated = res["violated_expression"]
+        violated = next((a for a in model_asserts if violated is not None and a <= violated), violated)
+        if mu.violates.startswith("assert:"):
+            rejected = bool(res["errors"]) and violated == ann.asserts[mu.violates[7:]][0]
+        else:  # the claim itself must fire, not a model assertion
+            rejected = bool(res["errors"]) and violated not in model_asserts
+        _progress(f"mutant {mu.name}: {'rejected' if rejected else 'SURVIVED'}")
+        return {"name": mu.name, "property": mu.violates, "text": mu.text, "expect": "rejected",
+                "verdict": "rejected" if rejected else "survived",
+                "errors": res["errors"], "states_stored": res["states_stored"], "depth": res["depth"],
+                "time_s": res["time_s"],
+                "counterexample": counterexample(wd, model.name, [mu.name]) if rejected else None}
+
+    _progress(f"checking {len(ann.mutants)} mutant models")
+    with ThreadPoolExecutor(max_workers=max(1, jobs)) as ex:
+        mutants = list(ex.map(run_mutant, ann.mutants))
+
+    result = {
+        "schema": "railproof/spin-results/1",
+        "model": f"models/{model.name}",
+        "model_sha256": sha256_file(model),
+        "spin_version": version,
+        "pan_flags": PAN_FLAGS,
+        "bounds": bounds,
+        "properties": props,
+        "mutants": mutants,
+        "wall_time_s": round(time.monotonic() - t0, 1),
+    }
+    out_json = Path(out_json)
+    out_json.parent.mkdir(parents=True, exist_ok=True)
+    tmp = out_json.with_suffix(".tmp")
+    tmp.write_text(json.dumps(result, indent=2, sort_keys=True) + "\n", encoding="utf-8")
+    tmp.replace(out_json)
+
+    failures = [p for p in props if p["verdict"] != "verified"]
+    survivors = [m for m in mutants if m["verdict"] != "rejected"]
+    if failures or survivors:
+        msg = []
+        for p in failures:
+            msg.append(f"property {p['name']} ({', '.join(p['requirements'])}) {p['verdict']}"
+                       + (f": {'; '.join(p['incomplete'])}" if p["incomplete"] else "")
+                       + (f"\ncounterexample:\n{p['counterexample']}" if p["counterexample"] else ""))
+        for m in survivors:
+            msg.append(f"mutant {m['name']} survived: property {m['property']} was not violated")
+        raise PipelineError(f"{model.name}: " + "\n".join(msg))
+    return result
+
+
+def register(sub):
+    p = sub.add_parser("verify", help="model-check every named property and every mutant of a model")
+    p.add_argument("--model", required=True)
+    p.add_argument("--params", required=True, help="directory with the generated <model>_params.pml")
+    p.add_argument("--work", required=True, help="scratch directory (build tree)")
+    p.add_argument("--out", required=True, help="results JSON")
+    p.add_argument("--jobs", type=int, default=os.cpu_count() or 1)
+    p.set_defaults(func=lambda a: (verify(Path(a.model), Path(a.params), Path(a.work), Path(a.out), a.jobs), 0)[1])
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit("use: python -m railproof_testgen verify ...")
