@@ -11,7 +11,7 @@ import sys
 
 from .errors import PipelineError, SpecError
 
-COMMAND_MODULES = ["params", "validate", "trace", "spin", "vectors", "evidence"]
+COMMAND_MODULES = ["params", "validate", "trace", "spin", "vectors", "evidence", "toolversions"]
 
 
 def build_parser():

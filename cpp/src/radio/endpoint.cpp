@@ -334,8 +334,10 @@ Endpoint::RxResult Endpoint::Receive(std::uint32_t now_ms, std::span<const std::
     reason = CheckTurnaround(history_index, now_ms);
   }
   if (reason != RejectReason::kNone) {
+    // The deletions before this in-sequence telegram are reported now, because peer_seq
+    // has moved past them (model: the gap printed with every verdict after check 6).
     Zero(plaintext);
-    return MakeRxResult(reason, 0, TelegramHeader{});
+    return MakeRxResult(reason, gap, TelegramHeader{});
   }
   // Accepted.
   last_accept_ms_ = now_ms;

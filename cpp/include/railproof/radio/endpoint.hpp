@@ -222,7 +222,9 @@ class Endpoint {
 
   struct RxResult {
     RejectReason reason;       // kNone: accepted
-    std::uint32_t gap;         // deleted telegrams reported with an acceptance while UP, else 0
+    std::uint32_t gap;         // deletions d - 1 detected by a telegram that passed checks 1-6
+                               // while the link was UP (accepted, or rejected by check 7/8:
+                               // peer_seq moved past them either way); else 0
     LinkState link;
     bool emergency_brake;
     bool tracking_abnormal;

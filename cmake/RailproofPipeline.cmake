@@ -1,0 +1,114 @@
+# The evidence pipeline (conventions §1): model checking -> vectors -> conformance ->
+# traceability -> evidence. Every step is a build product with its inputs as
+# dependencies, so a second run with nothing changed does nothing.
+#
+#   ALL       : SPIN verification of every property and mutant (fails on any violation,
+#               printing the counterexample), vector generation with goal coverage.
+#   evidence  : test results as JUnit XML (unit, conformance, testgen), residual-error
+#               analysis, tool versions, trace.json, and the rendered evidence package
+#               in ${CMAKE_BINARY_DIR}/evidence (HTML + manifest.json with SHA-256).
+set(RAILPROOF_MODELS telegram)
+set(RAILPROOF_VECTOR_DIR ${RAILPROOF_RESULTS_DIR}/vectors)
+set(_spin_outputs)
+set(_vector_outputs)
+foreach(model ${RAILPROOF_MODELS})
+  set(_pml ${RAILPROOF_SOURCE_DIR}/models/${model}.pml)
+  set(_spin_json ${RAILPROOF_RESULTS_DIR}/spin/${model}.json)
+  add_custom_command(
+    OUTPUT ${_spin_json}
+    COMMAND ${RAILPROOF_TESTGEN} verify --model ${_pml} --params ${RAILPROOF_GEN_DIR}/models
+            --work ${CMAKE_BINARY_DIR}/spin/${model}/verify --out ${_spin_json}
+    DEPENDS ${_pml} ${RAILPROOF_GEN_DIR}/models/${model}_params.pml ${RAILPROOF_TESTGEN_FILES}
+    COMMENT "SPIN: exhaustive verification of models/${model}.pml (properties, mutants)"
+    USES_TERMINAL VERBATIM)
+  set(_vec ${RAILPROOF_VECTOR_DIR}/${model}.jsonl)
+  add_custom_command(
+    OUTPUT ${_vec} ${RAILPROOF_VECTOR_DIR}/${model}.coverage.json
+    COMMAND ${RAILPROOF_TESTGEN} vectors --model ${_pml} --params ${RAILPROOF_GEN_DIR}/models
+            --spec ${RAILPROOF_SOURCE_DIR}/spec --work ${CMAKE_BINARY_DIR}/spin/${model}/vectors
+            --out ${RAILPROOF_VECTOR_DIR}
+    DEPENDS ${_spin_json} ${RAILPROOF_SPEC_FILES}
+    COMMENT "testgen: trap, boundary and random-walk vectors from models/${model}.pml"
+    USES_TERMINAL VERBATIM)
+  list(APPEND _spin_outputs ${_spin_json})
+  list(APPEND _vector_outputs ${_vec})
+endforeach()
+add_custom_target(railproof_models ALL DEPENDS ${_spin_outputs} ${_vector_outputs})
+
+# ---- evidence inputs that come from running things ------------------------------------
+set(_tests_dir ${RAILPROOF_RESULTS_DIR}/tests)
+file(GLOB_RECURSE _pytests CONFIGURE_DEPENDS ${RAILPROOF_SOURCE_DIR}/testgen/tests/*.py)
+add_custom_command(
+  OUTPUT ${_tests_dir}/unit.xml
+  COMMAND ${CMAKE_COMMAND} -E make_directory ${_tests_dir}
+  COMMAND railproof_unit_tests --gtest_output=xml:${_tests_dir}/unit.xml
+  DEPENDS railproof_unit_tests
+  COMMENT "tests: C++ unit tests -> results/tests/unit.xml" USES_TERMINAL VERBATIM)
+set(_evidence_tests ${_tests_dir}/unit.xml)
+if(TARGET railproof_conformance)
+  add_custom_command(
+    OUTPUT ${_tests_dir}/conformance.xml
+    COMMAND ${CMAKE_COMMAND} -E make_directory ${_tests_dir}
+    COMMAND railproof_conformance --vectors ${RAILPROOF_VECTOR_DIR}
+            --gtest_output=xml:${_tests_dir}/conformance.xml
+    DEPENDS railproof_conformance ${_vector_outputs}
+    COMMENT "tests: conformance replay of every vector -> results/tests/conformance.xml"
+    USES_TERMINAL VERBATIM)
+  list(APPEND _evidence_tests ${_tests_dir}/conformance.xml)
+endif()
+add_custom_command(
+  OUTPUT ${_tests_dir}/testgen.xml
+  COMMAND ${CMAKE_COMMAND} -E make_directory ${_tests_dir}
+  COMMAND ${CMAKE_COMMAND} -E env ${RAILPROOF_PY_ENV} ${RAILPROOF_PYTHON} -m pytest -q -p no:cacheprovider
+          ${RAILPROOF_SOURCE_DIR}/testgen/tests --junitxml=${_tests_dir}/testgen.xml
+  DEPENDS ${_pytests} ${RAILPROOF_TESTGEN_FILES}
+  COMMENT "tests: testgen (pytest) -> results/tests/testgen.xml" USES_TERMINAL VERBATIM)
+list(APPEND _evidence_tests ${_tests_dir}/testgen.xml)
+
+set(_residual ${RAILPROOF_RESULTS_DIR}/analysis/residual_error.json)
+add_custom_command(
+  OUTPUT ${_residual}
+  COMMAND ${CMAKE_COMMAND} -E make_directory ${RAILPROOF_RESULTS_DIR}/analysis
+  COMMAND residual_error --ber 1e-3 --ber 1e-4 --json ${_residual}
+  DEPENDS residual_error
+  COMMENT "analysis: residual error rate of RS(66,50)+CRC-16+MAC" VERBATIM)
+
+add_custom_target(railproof_analysis_results ALL DEPENDS ${_residual})
+
+set(_tools ${RAILPROOF_RESULTS_DIR}/tool-versions.json)
+add_custom_command(
+  OUTPUT ${_tools}
+  COMMAND ${RAILPROOF_TESTGEN} toolversions --out ${_tools} --compiler ${CMAKE_CXX_COMPILER}
+  DEPENDS ${RAILPROOF_SOURCE_DIR}/testgen/requirements.txt
+  COMMENT "evidence: recording tool versions" VERBATIM)
+
+set(_trace ${RAILPROOF_RESULTS_DIR}/trace.json)
+file(GLOB_RECURSE _traced_sources CONFIGURE_DEPENDS
+  ${RAILPROOF_SOURCE_DIR}/cpp/*.cpp ${RAILPROOF_SOURCE_DIR}/cpp/*.hpp ${RAILPROOF_SOURCE_DIR}/models/*.pml)
+add_custom_command(
+  OUTPUT ${_trace}
+  COMMAND ${RAILPROOF_TESTGEN} trace --spec ${RAILPROOF_SOURCE_DIR}/spec --src ${RAILPROOF_SOURCE_DIR}
+          --results ${RAILPROOF_RESULTS_DIR} --out ${_trace}
+  DEPENDS ${_spin_outputs} ${_vector_outputs} ${_residual} ${_traced_sources} ${RAILPROOF_SPEC_FILES}
+  COMMENT "trace: requirement <-> property/vector/code/test links" VERBATIM)
+
+set(_manifest ${CMAKE_BINARY_DIR}/evidence/manifest.json)
+file(GLOB_RECURSE _evidence_sources CONFIGURE_DEPENDS ${RAILPROOF_SOURCE_DIR}/evidence/*)
+add_custom_command(
+  OUTPUT ${_manifest}
+  COMMAND ${RAILPROOF_TESTGEN} evidence --spec ${RAILPROOF_SOURCE_DIR}/spec --results ${RAILPROOF_RESULTS_DIR}
+          --src ${RAILPROOF_SOURCE_DIR} --out ${CMAKE_BINARY_DIR}/evidence --tool-versions ${_tools}
+  DEPENDS ${_trace} ${_evidence_tests} ${_residual} ${_tools} ${_evidence_sources}
+  COMMENT "evidence: rendering the assessor's package (Sphinx + sphinx-needs)" USES_TERMINAL VERBATIM)
+add_custom_target(evidence DEPENDS ${_manifest})
+
+# ---- pipeline checks in the test suite --------------------------------------------------
+add_test(NAME testgen_pytest
+  COMMAND ${CMAKE_COMMAND} -E env ${RAILPROOF_PY_ENV} ${RAILPROOF_PYTHON} -m pytest -q -p no:cacheprovider
+          ${RAILPROOF_SOURCE_DIR}/testgen/tests)
+add_test(NAME traceability
+  COMMAND ${RAILPROOF_TESTGEN} trace --spec ${RAILPROOF_SOURCE_DIR}/spec --src ${RAILPROOF_SOURCE_DIR}
+          --results ${RAILPROOF_RESULTS_DIR} --out ${CMAKE_BINARY_DIR}/ctest-trace.json)
+add_test(NAME spec_validate
+  COMMAND ${RAILPROOF_TESTGEN} validate --spec ${RAILPROOF_SOURCE_DIR}/spec)
+set_tests_properties(testgen_pytest traceability spec_validate PROPERTIES LABELS pipeline)

@@ -1,0 +1,296 @@
+"""Derive conformance vectors from a SPIN model.
+
+Three kinds of vectors (spec/design/telegram-layer.md §7, schema spec/schemas/vectors.schema.json):
+- trap: every `// @goal K` becomes a trap property `[] !g[K]`; pan (BFS) returns the
+  shortest run that reaches the goal, whose replayed @IN/@OUT lines are the vector.
+  Goals whose label names a boundary, edge or wrap-around are the boundary vectors.
+- random: seeded random walks (`spin -n<seed> -u<steps>`); the seed is in the id.
+Each run of the model is emitted once per endpoint role (ground, train): the logic is
+the same, the identifiers, telegram types and safe-reaction output differ.
+A goal that the exhaustive search cannot reach must be justified in spec/justifications.
+"""
+from __future__ import annotations
+
+import json
+import os
+import re
+import shutil
+from concurrent.futures import ThreadPoolExecutor
+from pathlib import Path
+
+import jsonschema
+
+from . import __version__
+from . import spin as spin_mod
+from .errors import PipelineError, SpecError
+from .spec import load_yaml
+
+VERDICTS = ["ACCEPT", "REJ_INTEGRITY", "REJ_ADDRESS", "REJ_AUTH", "REJ_REPEATED", "REJ_SEQUENCE",
+            "REJ_NO_ECHO", "REJ_UNKNOWN_ECHO", "REJ_STALE"]
+LINKS = ["NONE", "UP", "LOST"]
+NONE = 255
+# delivery modes of the model (D_INTACT ... D_MISADDR)
+MODE_INTACT, MODE_DUP, MODE_CORRUPT, MODE_FORGE, MODE_MISADDR = range(5)
+
+# requirement evidenced by observing a verdict / transition in a run
+VERDICT_REQS = {
+    "ACCEPT": ["REQ-TG-008"], "REJ_INTEGRITY": ["REQ-TG-005"], "REJ_ADDRESS": ["REQ-TG-003"],
+    "REJ_AUTH": ["REQ-TG-007"], "REJ_REPEATED": ["REQ-TG-001"], "REJ_SEQUENCE": ["REQ-TG-004"],
+    "REJ_NO_ECHO": ["REQ-TG-012"], "REJ_UNKNOWN_ECHO": ["REQ-TG-008"],
+    "REJ_STALE": ["REQ-TG-006", "REQ-TG-009"],
+}
+LOST_REQS = ["REQ-TG-013", "REQ-TG-014", "REQ-TG-015"]
+BOUNDARY_WORDS = ("boundary", "edge", "wrap")
+
+_IN_TICK = re.compile(r"@IN tick")
+_IN_RX = re.compile(r"@IN rx seq=(\d+) echo=(\d+) mode=(\d+)")
+_OUT_TX = re.compile(r"@OUT tx seq=(\d+) echo=(\d+) link=(\d+) eb=(\d+) abnormal=(\d+)")
+_OUT_RX = re.compile(r"@OUT rx verdict=(\d+) gap=(\d+) link=(\d+) eb=(\d+) abnormal=(\d+)")
+
+
+def parse_events(text: str):
+    """Turn replay/simulation output into a list of raw (input, output) events."""
+    events, pending = [], None
+    for line in text.splitlines():
+        if m := _IN_TICK.search(line):
+            pending = {"ev": "tick"}
+        elif m := _IN_RX.search(line):
+            pending = {"ev": "rx", "seq": int(m[1]), "echo": int(m[2]), "mode": int(m[3])}
+        elif m := _OUT_TX.search(line):
+            if pending is None or pending["ev"] != "tick":
+                raise PipelineError(f"@OUT tx without @IN tick: {line.strip()}")
+            events.append((pending, {"seq": int(m[1]), "echo": int(m[2]), "link": int(m[3]),
+                                     "eb": int(m[4]), "abnormal": int(m[5])}))
+            pending = None
+        elif m := _OUT_RX.search(line):
+            if pending is None or pending["ev"] != "rx":
+                raise PipelineError(f"@OUT rx without @IN rx: {line.strip()}")
+            events.append((pending, {"verdict": int(m[1]), "gap": int(m[2]), "link": int(m[3]),
+                                     "eb": int(m[4]), "abnormal": int(m[5])}))
+            pending = None
+    # an input whose output was cut off by the end of a trail is dropped
+    return events
+
+
+def _role_out(role, o):
+    base = {"link": LINKS[o["link"]]}
+    if role == "train":
+        base["eb"] = bool(o["eb"])
+    else:
+        base["tracking"] = "ABNORMAL" if o["abnormal"] else "TRACKED"
+    return base
+
+
+def to_steps(events, role, ids):
+    """Map raw events to the vector step format of one endpoint role."""
+    steps = []
+    own, peer, other = (ids["ground_id"], ids["train_id"], ids["other_train_id"])
+    for i, o in events:
+        if i["ev"] == "tick":
+            out = {"tx": {"seq": o["seq"], "echo": None if o["echo"] == NONE else o["echo"]}}
+            out.update(_role_out(role, o))
+            steps.append({"in": {"ev": "tick"}, "out": out})
+            continue
+        mode = i["mode"]
+        if role == "ground":
+            src, dst, typ = peer, own, "POSITION"
+            if mode == MODE_MISADDR:
+                src = other
+        else:
+            src, dst, typ = own, peer, "CONTROL"
+            if mode == MODE_MISADDR:
+                dst = other
+        tg = {"src": src, "dst": dst, "type": typ, "seq": i["seq"],
+              "echo": None if i["echo"] == NONE else i["echo"],
+              "auth": "nokey" if mode == MODE_FORGE else "key",
+              "integrity": "corrupt" if mode == MODE_CORRUPT else "ok"}
+        out = {"verdict": VERDICTS[o["verdict"]], "gap": o["gap"]}
+        out.update(_role_out(role, o))
+        steps.append({"in": {"ev": "rx", "tg": tg}, "out": out})
+    return steps
+
+
+def observed_requirements(events):
+    reqs = set()
+    prev_link = 0
+    for i, o in events:
+        if i["ev"] == "rx":
+            reqs.update(VERDICT_REQS[VERDICTS[o["verdict"]]])
+        if prev_link == 1 and o["link"] == 2:
+            reqs.update(LOST_REQS)
+        prev_link = o["link"]
+    return reqs
+
+
+def write_goals_file(ann, path: Path):
+    lines = ["/* Generated by railproof_testgen vectors: one trap property per coverage goal. */"]
+    for g in ann.goals:
+        lines.append(f"ltl goal{g.number} {{ [] !g[{g.number}] }}")
+    path.write_text("\n".join(lines) + "\n", encoding="utf-8")
+
+
+def load_justifications(spec_dir: Path, model_rel: str):
+    out = {}
+    jdir = Path(spec_dir) / "justifications"
+    for f in sorted(jdir.glob("*.yaml")) if jdir.exists() else []:
+        data = load_yaml(f)
+        for e in data.get("justifications") or []:
+            if e.get("model") == model_rel:
+                out[str(e.get("goal"))] = e["id"]
+    return out
+
+
+def _progress(msg):
+    print(f"vectors: {msg}", flush=True)
+
+
+def generate(model: Path, params_dir: Path, spec_dir: Path, workdir: Path, out_dir: Path,
+             walks: int = 50, walk_steps: int = 7000, jobs: int = 2):
+    model = Path(model)
+    model_rel = f"models/{model.name}"
+    ann = spin_mod.parse_annotations(model)
+    if not ann.goals:
+        raise SpecError(model, "-", "no // @goal annotations: nothing to generate")
+    params_pml = Path(params_dir) / f"{model.stem}_params.pml"
+    bounds = spin_mod.read_bounds(params_pml)
+    workdir = Path(workdir)
+    workdir.mkdir(parents=True, exist_ok=True)
+    goals_file = workdir / f"{model.stem}_goals.pml"
+    write_goals_file(ann, goals_file)
+    _progress(f"compiling trap model ({len(ann.goals)} goals)")
+    base = spin_mod.prepare(model, params_dir, workdir / "traps", ["TRAPS"], [goals_file])
+
+    def run_goal(g):
+        wd = workdir / f"goal{g.number}"
+        if wd.exists():
+            shutil.rmtree(wd)
+        shutil.copytree(base, wd)
+        r = spin_mod._run(["./pan", "-N", f"goal{g.number}"], wd)
+        res = spin_mod.parse_pan(r.stdout + r.stderr)
+        if res["errors"]:
+            rep = spin_mod._run(["spin", "-DTRAPS", "-t", model.name], wd, timeout=300)
+            events = parse_events(rep.stdout)
+            if not events:
+                raise PipelineError(f"{model.name}: goal {g.gid} trail replay produced no events:\n{rep.stdout[-2000:]}")
+            return g, "reached", events, res
+        if res["incomplete"]:
+            raise PipelineError(f"{model.name}: goal {g.gid}: search incomplete ({'; '.join(res['incomplete'])})")
+        return g, "unreachable", None, res
+
+    with ThreadPoolExecutor(max_workers=max(1, jobs)) as ex:
+        outcomes = list(ex.map(run_goal, ann.goals))
+
+    justifications = load_justifications(spec_dir, model_rel)
+    ids = {"ground_id": bounds["ground_id"], "train_id": bounds["train_id"],
+           "other_train_id": bounds["other_train_id"]}
+    vectors, coverage, problems = [], [], []
+    for g, status, events, res in outcomes:
+        vec_ids = []
+        if status == "reached":
+            kind = "boundary" if any(w in g.label.lower() for w in BOUNDARY_WORDS) else "trap"
+            reqs = sorted(set(g.requirements) | observed_requirements(events))
+            for role in ("ground", "train"):
+                vid = f"TG-{kind.upper()}-{g.gid}-{role}"
+                vec_ids.append(vid)
+                vectors.append({"id": vid, "role": role, "requirements": reqs, "goal": g.gid,
+                                "kind": kind, "seed": None, "steps": to_steps(events, role, ids)})
+            _progress(f"{g.gid} reached in {len(events)} steps: {g.label}")
+        else:
+            _progress(f"{g.gid} UNREACHABLE ({res['states_stored']} states searched): {g.label}")
+        just = justifications.get(g.gid)
+        if status == "unreachable" and not just:
+            problems.append(f"goal {g.gid} ({g.label}) is unreachable and has no justification in "
+                            f"spec/justifications/ (model {model_rel})")
+        coverage.append({"id": g.gid, "label": g.label, "requirements": g.requirements, "status": status,
+                         "vectors": vec_ids, "justification": just if status == "unreachable" else None,
+                         "states_searched": res["states_stored"] if status == "unreachable" else None})
+    for gid in sorted(set(justifications) - {c["id"] for c in coverage if c["status"] == "unreachable"}):
+        problems.append(f"justification {justifications[gid]} names goal {gid}, which is reached or unknown")
+
+    _progress(f"{walks} random walks of {walk_steps} SPIN statements each")
+    sim_dir = workdir / "traps"
+
+    def walk(seed):
+        # spin writes scratch files into its working directory: one directory per walk
+        wd = workdir / f"walk{seed}"
+        if wd.exists():
+            shutil.rmtree(wd)
+        wd.mkdir()
+        for f in sim_dir.glob("*.pml"):
+            shutil.copy2(f, wd / f.name)
+        r = spin_mod._run(["spin", f"-n{seed}", f"-u{walk_steps}", model.name], wd, timeout=300)
+        if r.returncode != 0:
+            raise PipelineError(f"spin simulation seed {seed} failed: {r.stderr[-1000:]}")
+        return seed, parse_events(r.stdout)
+
+    with ThreadPoolExecutor(max_workers=max(1, jobs)) as ex:
+        walks_out = list(ex.map(walk, range(1, walks + 1)))
+    for seed, events in walks_out:
+        if not events:
+            raise PipelineError(f"random walk seed {seed} produced no events")
+        reqs = sorted(observed_requirements(events))
+        for role in ("ground", "train"):
+            vectors.append({"id": f"TG-RANDOM-S{seed}-{role}", "role": role, "requirements": reqs,
+                            "goal": None, "kind": "random", "seed": seed,
+                            "steps": to_steps(events, role, ids)})
+
+    header = {
+        "kind": "header", "schema_version": 1, "model": model_rel,
+        "model_sha256": spin_mod.sha256_file(model),
+        "generator": f"railproof_testgen {__version__}", "spin_version": spin_mod.spin_version(),
+        "unit_scales": {"time_ms_per_tick": bounds["tick_ms"]},
+        "parameters": {
+            "seq_modulus": bounds["seq_modulus"], "seq_window": bounds["seq_window"],
+            "history_depth": bounds["history_depth"],
+            "turnaround_ms": bounds["turnaround_ticks"] * bounds["tick_ms"],
+            "link_timeout_ms": bounds["link_ticks"] * bounds["tick_ms"],
+            "echo_validity_ms": bounds["echo_ticks"] * bounds["tick_ms"],
+            "init_own_seq": bounds["init_own_seq"], "init_peer_seq": bounds["init_peer_seq"],
+            **ids},
+    }
+    schema = json.loads((Path(spec_dir) / "schemas" / "vectors.schema.json").read_text(encoding="utf-8"))
+    validator = jsonschema.Draft202012Validator(schema)
+    lines = [header, *vectors]
+    for n, obj in enumerate(lines, 1):
+        err = next(iter(validator.iter_errors(obj)), None)
+        if err:
+            raise PipelineError(f"generated vector line {n} violates the vector schema: "
+                                f"{'/'.join(map(str, err.path))}: {err.message}")
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    reached = sum(1 for c in coverage if c["status"] == "reached")
+    cov = {"schema": "railproof/coverage/1", "model": model_rel, "goals": coverage, "reached": reached,
+           "labelled": len(coverage), "unreachable_justified": sum(
+               1 for c in coverage if c["status"] == "unreachable" and c["justification"]),
+           "vectors": {"trap": sum(v["kind"] == "trap" for v in vectors),
+                       "boundary": sum(v["kind"] == "boundary" for v in vectors),
+                       "random": sum(v["kind"] == "random" for v in vectors)}}
+    _atomic_write(out_dir / f"{model.stem}.jsonl",
+                  "".join(json.dumps(o, sort_keys=True, separators=(",", ":")) + "\n" for o in lines))
+    _atomic_write(out_dir / f"{model.stem}.coverage.json", json.dumps(cov, indent=2, sort_keys=True) + "\n")
+    _progress(f"goal coverage {reached}/{len(coverage)} reached, "
+              f"{cov['unreachable_justified']} unreachable justified; {len(vectors)} vectors written")
+    if problems:
+        raise PipelineError(f"{model.name}: " + "; ".join(problems))
+    return cov
+
+
+def _atomic_write(path: Path, text: str):
+    tmp = path.with_suffix(path.suffix + ".tmp")
+    tmp.write_text(text, encoding="utf-8")
+    tmp.replace(path)
+
+
+def register(sub):
+    p = sub.add_parser("vectors", help="derive conformance vectors (trap goals, boundaries, random walks)")
+    p.add_argument("--model", required=True)
+    p.add_argument("--params", required=True, help="directory with the generated <model>_params.pml")
+    p.add_argument("--spec", required=True, help="spec/ directory (schemas, justifications)")
+    p.add_argument("--work", required=True)
+    p.add_argument("--out", required=True, help="output directory for <model>.jsonl and coverage")
+    p.add_argument("--walks", type=int, default=50)
+    p.add_argument("--walk-steps", type=int, default=7000,
+                   help="length of each random walk in SPIN statements (about 60 per event)")
+    p.add_argument("--jobs", type=int, default=os.cpu_count() or 1)
+    p.set_defaults(func=lambda a: (generate(Path(a.model), Path(a.params), Path(a.spec), Path(a.work),
+                                            Path(a.out), a.walks, a.walk_steps, a.jobs), 0)[1])
