@@ -245,16 +245,19 @@ void Usage(std::FILE* out) {
                "usage: railproof_conformance --vectors DIR [--junit FILE] [gtest flags]\n"
                "Replays every vector of DIR/*.jsonl (spec/design/telegram-layer.md §7) against the\n"
                "radio endpoint; one test per vector. --junit FILE writes JUnit XML (same as\n"
-               "--gtest_output=xml:FILE). Exit status 0 only if the set is non-empty, well formed\n"
-               "and every vector passes.\n");
+               "--gtest_output=xml:FILE); other --gtest_* flags are passed to GoogleTest.\n"
+               "Exit status 0 only if the set is non-empty, well formed and every vector passes;\n"
+               "1 if not; 2 on bad arguments.\n");
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  testing::InitGoogleTest(&argc, argv);  // removes the gtest flags it recognises
+  // Own flags first; everything else goes to GoogleTest (--junit becomes --gtest_output,
+  // which GoogleTest reads during InitGoogleTest).
   std::string vectors_dir;
   std::string junit;
+  std::vector<std::string> gtest_args = {argc > 0 ? argv[0] : "railproof_conformance"};
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
     if (arg == "--help" || arg == "-h") {
@@ -267,6 +270,8 @@ int main(int argc, char** argv) {
       vectors_dir = arg.substr(std::strlen("--vectors="));
     } else if (arg.rfind("--junit=", 0) == 0) {
       junit = arg.substr(std::strlen("--junit="));
+    } else if (arg.rfind("--gtest_", 0) == 0) {
+      gtest_args.push_back(arg);
     } else {
       std::fprintf(stderr, "railproof-conformance: error: unknown or incomplete argument \"%s\" (see --help)\n",
                    arg.c_str());
@@ -278,7 +283,18 @@ int main(int argc, char** argv) {
     return 2;
   }
   if (!junit.empty()) {
-    GTEST_FLAG_SET(output, "xml:" + junit);
+    gtest_args.push_back("--gtest_output=xml:" + junit);
+  }
+  std::vector<char*> gtest_argv;
+  for (std::string& a : gtest_args) {
+    gtest_argv.push_back(a.data());
+  }
+  gtest_argv.push_back(nullptr);
+  int gtest_argc = static_cast<int>(gtest_args.size());
+  testing::InitGoogleTest(&gtest_argc, gtest_argv.data());
+  if (gtest_argc > 1) {
+    std::fprintf(stderr, "railproof-conformance: error: unknown GoogleTest flag \"%s\"\n", gtest_argv[1]);
+    return 2;
   }
 
   rc::LoadResult loaded = rc::LoadVectorDirectory(vectors_dir);

@@ -96,9 +96,9 @@ T OneOf(const json& object, const char* key, const std::string& where,
 }
 
 void OnlyKeys(const json& object, const std::string& where, std::initializer_list<const char*> allowed) {
-  for (const auto& [key, value] : object.items()) {
-    (void)value;
-    if (std::none_of(allowed.begin(), allowed.end(), [&](const char* a) { return key == a; })) {
+  for (auto it = object.begin(); it != object.end(); ++it) {
+    const std::string& key = it.key();
+    if (std::none_of(allowed.begin(), allowed.end(), [&key](const char* a) { return key == a; })) {
       throw FormatError("unknown field \"" + Name(where, key.c_str()) + "\"");
     }
   }

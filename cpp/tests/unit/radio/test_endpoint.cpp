@@ -645,6 +645,31 @@ TEST(EndpointSequence, OwnNumbersWrapAndEchoesAcrossTheWrapAreFound) {
   EXPECT_EQ(r.reason, RejectReason::kNone);
 }
 
+// The conformance configuration reduces the modulus (design §3, §7): numbers wrap at M, and
+// a number >= M, which no genuine peer sends, is out of sequence even before the link is up.
+// @verifies REQ-TG-004
+// @verifies REQ-TG-017
+TEST(EndpointSequence, ReducedModulusOfTheModelConfiguration) {
+  namespace m = p::model;
+  EndpointConfig c = TrainConfig();
+  c.seq_modulus = static_cast<std::uint64_t>(m::model_seq_modulus);
+  c.seq_window = static_cast<std::uint32_t>(m::model_seq_window);
+  c.history_depth = static_cast<std::uint32_t>(m::model_history_depth);
+  c.initial_seq = static_cast<std::uint32_t>(m::model_seq_modulus - 1);
+  ASSERT_EQ(Validate(c), ConfigError::kNone);
+  Harness h(c);
+  const auto top = static_cast<std::uint32_t>(m::model_seq_modulus - 1);
+  EXPECT_EQ(h.Cycle(0).tx.seq, top);
+  EXPECT_EQ(h.Cycle(100).tx.seq, 0U);  // wrapped at M
+  EXPECT_EQ(h.Rx(100, PeerTelegram{.seq = top + 1U, .echo = 0}).reason, RejectReason::kOutOfSequence);
+  EXPECT_EQ(h.Cycle(200).tx.echo_valid, false);  // nothing taken from it
+  auto r = h.Rx(200, PeerTelegram{.seq = top, .echo = 0});
+  EXPECT_EQ(r.reason, RejectReason::kNone);
+  r = h.Rx(200, PeerTelegram{.seq = c.seq_window - 1U, .echo = 1});  // top + W mod M
+  EXPECT_EQ(r.reason, RejectReason::kNone);
+  EXPECT_EQ(r.gap, c.seq_window - 1U);
+}
+
 // @verifies REQ-TG-001
 TEST(EndpointSequence, ReplayOfAnAcceptedFrameIsRejected) {
   Harness h(TrainConfig(0));
