@@ -30,7 +30,7 @@ std::array<std::uint8_t, 66> MakeCodeword(std::uint32_t seed) {
   return cw;
 }
 
-// @implements REQ-TG-010
+// Measures REQ-TG-010
 void BM_Rs6650Encode(benchmark::State& state) {
   const ReedSolomon& rs = Rs6650();
   std::array<std::uint8_t, 50> msg{};
@@ -47,7 +47,7 @@ void BM_Rs6650Encode(benchmark::State& state) {
 BENCHMARK(BM_Rs6650Encode);
 
 // Decode of an error-free block (syndromes only). Each iteration copies the 66-byte block.
-// @implements REQ-TG-010
+// Measures REQ-TG-010
 void BM_Rs6650DecodeClean(benchmark::State& state) {
   const ReedSolomon& rs = Rs6650();
   const auto cw = MakeCodeword(1);
@@ -61,7 +61,7 @@ void BM_Rs6650DecodeClean(benchmark::State& state) {
 BENCHMARK(BM_Rs6650DecodeClean);
 
 // Decode with t = 8 symbol errors (the full correction path: BM, Chien, Forney, re-check).
-// @implements REQ-TG-010
+// Measures REQ-TG-010
 void BM_Rs6650Decode8Errors(benchmark::State& state) {
   const ReedSolomon& rs = Rs6650();
   auto corrupted = MakeCodeword(2);
@@ -79,7 +79,7 @@ void BM_Rs6650Decode8Errors(benchmark::State& state) {
 BENCHMARK(BM_Rs6650Decode8Errors);
 
 // Decode of a word beyond the radius (9 errors): rejected after BM / Chien.
-// @implements REQ-TG-010
+// Measures REQ-TG-010
 void BM_Rs6650Decode9ErrorsRejected(benchmark::State& state) {
   const ReedSolomon& rs = Rs6650();
   auto corrupted = MakeCodeword(3);
@@ -95,7 +95,7 @@ void BM_Rs6650Decode9ErrorsRejected(benchmark::State& state) {
 }
 BENCHMARK(BM_Rs6650Decode9ErrorsRejected);
 
-// @implements REQ-TG-005
+// Measures REQ-TG-005
 void BM_Crc16(benchmark::State& state) {
   std::vector<std::uint8_t> data(static_cast<std::size_t>(state.range(0)));
   for (std::size_t i = 0; i < data.size(); ++i) {

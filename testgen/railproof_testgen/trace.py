@@ -69,7 +69,7 @@ FAILED_VERDICTS = {"fail", "failed", "violated", "error"}
 
 # Tags open a comment: prose that merely mentions "@implements" is not a tag, and the
 # usage examples inside a model's /* ... */ header are not either.
-_MODEL_TAG = re.compile(r"^\s*//+\s*@(property|goal|mutant)\b(.*)$")
+_MODEL_TAG = re.compile(r"^\s*//+\s*@(property|goal|mutant|assert)\b(.*)$")
 _CPP_TAG = re.compile(r"(?:^\s*\*+|//+|/\*+)\s*@(implements|verifies)\b(.*)$")
 _PROOF_TAG = re.compile(r"(?:^\s*\*+|;+|#+|//+|/\*+)\s*@(verifies|obligation)\b(.*)$")
 _TEST_MACRO = re.compile(
@@ -227,6 +227,11 @@ class Tracer:
                     self.error(f, entry, "tag names no requirement")
                 if tag == "property":
                     self._model_property(f, n, entry, name, ids, text.strip())
+                elif tag == "assert":
+                    # a named model assertion: checked in every verification run of its
+                    # model; mutants may name it as "assert:<label>"
+                    self._model_property(f, n, entry, f"assert:{name}", ids, text.strip())
+                    self.properties[f"assert:{name}"]["assertion"] = True
                 else:
                     self._model_goal(f, n, entry, _goal_id(name), ids, text.strip())
         for name, mu in sorted(self.mutants.items()):
@@ -235,6 +240,8 @@ class Tracer:
                            f"dangling reference: no @property named {mu['property']}")
         text = "\n".join("\n".join(self.read_lines(f) or []) for f in files)
         for name, p in sorted(self.properties.items()):
+            if p.get("assertion"):
+                continue
             if not re.search(rf"\bltl\s+{re.escape(name)}\b", text):
                 self.warn(p["files"][0], f"@property {name}",
                           "no 'ltl' formula with this name in models/")
@@ -307,7 +314,7 @@ class Tracer:
                 if name:
                     seen_mutants.add(name)
         for name, p in sorted(self.properties.items()):
-            if not p["results"]:
+            if not p["results"] and not p.get("assertion"):
                 self.error(p["files"][0], f"@property {name} (line {p['line']})",
                            "property has no model-checking result", p["requirements"])
         for name, mu in sorted(self.mutants.items()):
@@ -486,14 +493,19 @@ class Tracer:
             reqs = sorted(set(ids) | set(ann["requirements"]))
             status = g.get("status")
             vec = g.get("vector")
+            vec_list = g.get("vectors")
+            if not isinstance(vec_list, list):
+                vec_list = [vec] if isinstance(vec, str) else []
+            vec = vec_list[0] if vec_list else None
             jid = g.get("justification")
             if status == "reached":
                 reached += 1
-                if not isinstance(vec, str):
+                if not vec_list or not all(isinstance(v, str) for v in vec_list):
                     self.error(f, entry, "reached goal names no vector", reqs)
-                elif vec not in self.vectors:
-                    self.error(f, entry, f"dangling reference: vector {vec} not in "
-                                         "vectors/*.jsonl", reqs)
+                for v in vec_list:
+                    if isinstance(v, str) and v not in self.vectors:
+                        self.error(f, entry, f"dangling reference: vector {v} not in "
+                                             "vectors/*.jsonl", reqs)
             elif status == "unreachable":
                 if not isinstance(jid, str) or not jid:
                     self.error(f, entry, "unreachable goal without a justification "
@@ -562,6 +574,10 @@ class Tracer:
                         self.warn(f, entry, "@verifies outside cpp/tests is not a test link")
                         continue
                     test = self._test_after(lines, n)
+                    if test is None and any("LLVMFuzzerTestOneInput" in ln
+                                            for ln in self._code_lines_after(lines, n)[:1]):
+                        # a libFuzzer target (run by ctest for a bounded time) is a test
+                        test = f"fuzz:{Path(rel).stem}"
                     if test is None:
                         self.warn(f, entry, "@verifies is not directly above a TEST(...)")
                         test = self._unit_after(line, lines, n) or f"(line {n})"

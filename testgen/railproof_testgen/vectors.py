@@ -210,15 +210,16 @@ def generate(model: Path, params_dir: Path, spec_dir: Path, workdir: Path, out_d
     _progress(f"{walks} random walks of {walk_steps} SPIN statements each")
     sim_dir = workdir / "traps"
 
-    def walk(seed):
+    def walk(seed, config=None):
         # spin writes scratch files into its working directory: one directory per walk
-        wd = workdir / f"walk{seed}"
+        wd = workdir / f"walk{seed}{'-' + config if config else ''}"
         if wd.exists():
             shutil.rmtree(wd)
         wd.mkdir()
         for f in sim_dir.glob("*.pml"):
             shutil.copy2(f, wd / f.name)
-        r = spin_mod._run(["spin", f"-n{seed}", f"-u{walk_steps}", model.name], wd, timeout=300)
+        dflags = [f"-D{config}"] if config else []
+        r = spin_mod._run(["spin", *dflags, f"-n{seed}", f"-u{walk_steps}", model.name], wd, timeout=300)
         if r.returncode != 0:
             raise PipelineError(f"spin simulation seed {seed} failed: {r.stderr[-1000:]}")
         return seed, parse_events(r.stdout)
@@ -233,6 +234,22 @@ def generate(model: Path, params_dir: Path, spec_dir: Path, workdir: Path, out_d
             vectors.append({"id": f"TG-RANDOM-S{seed}-{role}", "role": role, "requirements": reqs,
                             "goal": None, "kind": "random", "seed": seed,
                             "steps": to_steps(events, role, ids)})
+
+    # Walks in the other configurations of the model (e.g. HEALTHY: a perfect channel),
+    # evidence for the properties verified in that configuration.
+    for config in sorted({p.config for p in ann.properties if p.config}):
+        creqs = sorted({r for p in ann.properties if p.config == config for r in p.requirements})
+        n_cfg = max(1, walks // 10)
+        _progress(f"{n_cfg} random walks in configuration {config}")
+        for seed in range(1, n_cfg + 1):
+            _, events = walk(seed, config)
+            if not events:
+                raise PipelineError(f"random walk seed {seed} [{config}] produced no events")
+            reqs = sorted(set(creqs) | observed_requirements(events))
+            for role in ("ground", "train"):
+                vectors.append({"id": f"TG-RANDOM-{config}S{seed}-{role}", "role": role,
+                                "requirements": reqs, "goal": None, "kind": "random", "seed": seed,
+                                "steps": to_steps(events, role, ids)})
 
     header = {
         "kind": "header", "schema_version": 1, "model": model_rel,
