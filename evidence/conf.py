@@ -76,10 +76,16 @@ needs_extra_options = [
     {"name": "spin_errors", "description": "errors SPIN reported"},
     {"name": "time_s", "description": "SPIN run time in seconds"},
     {"name": "memory_mb", "description": "SPIN memory in MiB"},
+    {"name": "transitions", "description": "transitions SPIN explored"},
+    {"name": "configuration", "description": "model configuration a property is checked in"},
+    {"name": "property_kind", "description": "ltl (a named LTL property) or assertion (a named assert() of the model)"},
     {"name": "expect", "description": "expected verdict of a mutant"},
     {"name": "goal", "description": "test-generation goal a vector reaches"},
     {"name": "steps", "description": "number of steps of a vector"},
     {"name": "vector_file", "description": "vector file the vector belongs to"},
+    {"name": "kind", "description": "how a vector was generated (trap, boundary, random)"},
+    {"name": "role", "description": "endpoint a vector drives (train or ground)"},
+    {"name": "conformance", "description": "result of replaying a vector against the C++ implementation"},
     {"name": "analysis", "description": "analysis result file"},
     {"name": "outcome", "description": "pass or fail of an analysis against its target"},
 ]
@@ -90,6 +96,7 @@ needs_extra_links = [
     {"option": "model_checks", "outgoing": "checks", "incoming": "checked by property"},
     {"option": "exercises", "outgoing": "exercises", "incoming": "exercised by vector"},
     {"option": "verifies", "outgoing": "verifies", "incoming": "verified by test"},
+    {"option": "replays", "outgoing": "replays vector", "incoming": "replayed by"},
     {"option": "quantifies", "outgoing": "quantifies", "incoming": "quantified by"},
     {"option": "targets", "outgoing": "must be killed by", "incoming": "kills mutant"},
 ]
@@ -108,4 +115,4 @@ needs_reproducible_json = True
 # paths shown in the pages are relative to the results directory.
 tr_rootdir = Path(__file__).resolve().parent.parent / "inputs" / "results"
 # Test cases name the requirements they verify (from trace.json) and the vector they replay.
-tr_extra_options = ["verifies"]
+tr_extra_options = ["verifies", "replays"]

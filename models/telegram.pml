@@ -33,6 +33,9 @@
  *   // @goal <K> <REQ ids> : label          (coverage goal K, trap property [] !g[K])
  *   // @mutant <NAME> violates <ltl name> | assert:<label> : text
  *   // @assert <label> <REQ ids> : text     (on the line before an assert(...))
+ *   // @variant <DEFINE> <param>=<model bound> : text   (a boundary variant: every default
+ *      property is verified in it too, and it supplies vectors for goals unreachable in
+ *      the main configuration; the vector header carries the overridden parameter)
  */
 #include "telegram_params.pml"
 
@@ -41,7 +44,11 @@
 #else
 #define M MODEL_SEQ_MODULUS
 #endif
+#ifdef VARIANT_NARROW_WINDOW
+#define W MODEL_NARROW_SEQ_WINDOW   /* boundary variant: the edge W + 1 becomes reachable */
+#else
 #define W MODEL_SEQ_WINDOW
+#endif
 #define H MODEL_HISTORY_DEPTH
 #define T_TA MODEL_TURNAROUND_TICKS
 #define T_LINK MODEL_LINK_TICKS
@@ -473,6 +480,9 @@ ltl REQ_TG_015_ground_reaction { [] (link != 1 -> abnormal) }
 // @property REQ_TG_016_availability REQ-TG-016 : on a healthy channel the link is up from the third tick on [config HEALTHY]
 ltl REQ_TG_016_availability { [] (boot >= 3 -> link == 1) }
 #endif
+
+/* --------------------------------------------------------------- variants --------- */
+// @variant VARIANT_NARROW_WINDOW seq_window=narrow_seq_window : sequence window below T_TA + T_LINK, so that the window edge W + 1 (goal G12) is reachable
 
 /* ---------------------------------------------------------------- mutants --------- */
 // @mutant MUTANT_NO_TURNAROUND_CHECK violates REQ_TG_009_turnaround : echo found but its age is not compared with T_TA

@@ -8,8 +8,11 @@
 2. copies every input verbatim to OUT/inputs, copies the Sphinx sources of REPO/evidence to
    OUT/src and writes the generated reStructuredText pages beside them (rendered from the
    Jinja templates in evidence/templates): one sphinx-needs need per requirement, hazard,
-   assumption, model property, mutant, vector and analysis result, JUnit results through
-   sphinx-test-reports;
+   assumption, model property, named model assertion, mutant, vector and analysis result,
+   one page per requirement with its properties, vectors, conformance and unit results,
+   and the JUnit results through sphinx-test-reports (a test whose name or result
+   sphinx-test-reports cannot address exactly is rendered from this module's own parse of
+   the XML as a need of the same type, see ``_reports_plan``);
 3. runs ``sphinx-build -b html`` into OUT/html with SOURCE_DATE_EPOCH, PYTHONHASHSEED and the
    locale fixed, fails on any error, and writes OUT/manifest.json + OUT/manifest.sha256
    (SHA-256 of every input copy, generated source and rendered file) and OUT/evidence.json
@@ -78,18 +81,56 @@ def need_id(*parts: str, upper: bool = True) -> str:
     return nid
 
 
+def _no_dynamic(text: str) -> str:
+    """sphinx-needs reads ``[[...]]`` in a need's fields and content as a dynamic function
+    call; adjacent brackets are spaced apart so input text is never executed."""
+    text = re.sub(r"\[(?=\[)", "[ ", text)
+    return re.sub(r"\](?=\])", "] ", text)
+
+
 def rst_escape(value) -> str:
     """Escape inline reStructuredText markup characters; newlines become spaces; a leading
-    list, enumeration or comment marker is escaped so a table cell stays one paragraph."""
+    list, enumeration or comment marker is escaped so a table cell stays one paragraph;
+    ``[[``/``]]`` are spaced apart (see _no_dynamic)."""
     text = _RST_SPECIAL.sub(r"\\\1", " ".join(str(value).split()))
     if _RST_BLOCK_START.match(text):
         text = "\\" + text
-    return text
+    return _no_dynamic(text)
 
 
 def one_line(value) -> str:
-    """Directive arguments and option values: one line, no leading/trailing blanks."""
-    return " ".join(str(value).split())
+    """Directive arguments and option values: one line, no leading/trailing blanks, no
+    ``[[``/``]]`` (see _no_dynamic)."""
+    return _no_dynamic(" ".join(str(value).split()))
+
+
+def display_text(value) -> str:
+    """Arbitrary text (a test name from a JUnit file) shown on one line: every character
+    that would break a line or is invisible (controls, Unicode line and paragraph
+    separators, tabs) is written as its Python escape (``\\n``, ``\\t``, ``\\u2028``),
+    leading and trailing blanks are kept visible the same way, and ``[[``/``]]`` are spaced
+    apart. The exact text is shown beside it in a literal block."""
+    text = str(value)
+    out = []
+    for i, ch in enumerate(text):
+        if ch == " " and (i == 0 or i == len(text) - 1):
+            out.append("\\x20")
+        elif ch.isprintable():
+            out.append(ch)
+        else:
+            out.append(repr(ch)[1:-1])
+    return _no_dynamic("".join(out)) or "(empty)"
+
+
+_PLAIN = re.compile(r"[!-~](?:[ -~]*[!-~])?")
+_NOT_PLAIN = re.compile(r"  |\[\[|\]\]|<<|>>")
+
+
+def plain_option(value: str) -> bool:
+    """True if value passes unchanged through a one-line reStructuredText directive option
+    and a sphinx-needs field: printable ASCII, no leading/trailing or double blanks, no
+    dynamic-function or variant markers."""
+    return bool(_PLAIN.fullmatch(value)) and not _NOT_PLAIN.search(value)
 
 
 def fmt_value(v) -> str:
@@ -118,9 +159,7 @@ def safe_json_line(obj) -> str:
     """One JSON line for display inside need content. sphinx-needs treats ``[[`` ... ``]]``
     in need content as a dynamic function, so adjacent brackets are spaced apart (the
     verbatim file is linked beside it)."""
-    text = json.dumps(obj, sort_keys=True, ensure_ascii=False)
-    text = re.sub(r"\[(?=\[)", "[ ", text)
-    return re.sub(r"\](?=\])", "] ", text)
+    return _no_dynamic(json.dumps(obj, sort_keys=True, ensure_ascii=False))
 
 
 def sha256_file(path: Path) -> str:
@@ -166,13 +205,28 @@ class JUnitCase:
     name: str
     result: str       # passed | failure | error | skipped
     time: str
+    properties: dict = field(default_factory=dict)   # <properties><property name= value=>
+    message: str = ""  # message attribute of <failure>/<error>/<skipped>
+    text: str = ""     # text of <failure>/<error>/<skipped>
+    system_out: str = ""
+    index: int = 0     # position among the <testcase> children of its suite
+
+
+@dataclass
+class JUnitSuite:
+    name: str
+    cases: list            # [JUnitCase]
+    nested: bool           # below another <testsuite>
+    top_index: int | None  # position among the file's top-level suites (None when nested)
 
 
 @dataclass
 class JUnitFile:
     rel: str          # relative to the results directory (posix)
-    suites: list      # [(suite name, [JUnitCase], nested)]
+    suites: list      # [JUnitSuite] (every suite with at least one case, nested ones flattened)
     error_elements: int = 0
+    reports_view: list | None = None   # sphinx-test-reports' own parse of the file
+    reports_error: str = ""            # why that parse is not available
 
 
 @dataclass
@@ -190,6 +244,8 @@ class Inputs:
     coverage: list = field(default_factory=list)      # [(rel, data)]
     junit: list = field(default_factory=list)         # [JUnitFile]
     analysis: list = field(default_factory=list)      # [(rel, data)]
+    justifications: dict = field(default_factory=dict)  # UR id -> entry (spec/justifications)
+    model_sources: dict = field(default_factory=dict)   # model path -> text (None: not found)
     tool_versions: dict | None = None
     tool_versions_name: str | None = None
     files: list = field(default_factory=list)         # [InputFile]
@@ -234,6 +290,19 @@ def _load_spec(inp: Inputs) -> None:
         inp.files.append(InputFile(f, f"spec/{_rel(f, spec_dir)}"))
     if not params:
         inp.missing.append("spec/parameters")
+    # Justifications of unreachable goals (optional: only needed when a goal is unreachable).
+    for f in spec_mod.spec_files(spec_dir, "justifications"):
+        data = spec_mod.load_yaml(f)
+        entries = data.get("justifications") or []
+        if not isinstance(entries, list):
+            raise SpecError(f, "justifications", "must be a list")
+        for i, e in enumerate(entries):
+            if not isinstance(e, dict) or "id" not in e:
+                raise SpecError(f, f"justifications[{i}]", "entry needs an 'id'")
+            if e["id"] in inp.justifications:
+                raise SpecError(f, e["id"], "duplicate id")
+            inp.justifications[str(e["id"])] = dict(e, _file=f.name)
+        inp.files.append(InputFile(f, f"spec/{_rel(f, spec_dir)}"))
 
 
 def _load_trace(inp: Inputs) -> None:
@@ -272,6 +341,27 @@ def _load_spin(inp: Inputs) -> None:
         rel = _rel(f, inp.results_dir)
         inp.spin.append((rel, data))
         inp.files.append(InputFile(f, f"results/{rel}"))
+        _load_model_source(inp, data.get("model"))
+
+
+def _load_model_source(inp: Inputs, model) -> None:
+    """The checked model's source, when the result names a file inside the source tree: its
+    ``// @assert`` annotations name the model assertions; a verbatim copy goes to
+    inputs/source/. Absent or outside the tree: the assertions are known only by the
+    names that mutants and trace.json give them."""
+    if not isinstance(model, str) or not model or model in inp.model_sources:
+        return
+    root = inp.repo_root.resolve()
+    path = (inp.repo_root / model).resolve()
+    if root not in path.parents or not path.is_file():
+        inp.model_sources[model] = None
+        return
+    try:
+        inp.model_sources[model] = path.read_text(encoding="utf-8", errors="replace")
+    except OSError:
+        inp.model_sources[model] = None
+        return
+    inp.files.append(InputFile(path, f"source/{path.relative_to(root).as_posix()}"))
 
 
 def _load_vectors(inp: Inputs) -> None:
@@ -331,25 +421,53 @@ def _parse_junit(path: Path, rel: str) -> JUnitFile:
         raise PipelineError(f"{path}: not JUnit XML (root element <{root.tag}>)")
     suites, errors = [], 0
     top = [root] if root.tag == "testsuite" else root.findall("testsuite")
-    for ts in top:
+    for k, ts in enumerate(top):
         # Suites nested below the top level are flattened and flagged: sphinx-test-reports
-        # 1.3.1 looks suites up by name at the top level only, so those are shown as tables.
+        # 1.3.1 looks suites up by name at the top level only.
         for s in ts.iter("testsuite"):
             cases = []
-            for tc in s.findall("testcase"):
-                if tc.find("failure") is not None:
-                    result = "failure"
-                elif tc.find("error") is not None:
-                    result, errors = "error", errors + 1
-                elif tc.find("skipped") is not None:
-                    result = "skipped"
+            for i, tc in enumerate(s.findall("testcase")):
+                outcome = None
+                for tag in ("failure", "error", "skipped"):
+                    outcome = tc.find(tag)
+                    if outcome is not None:
+                        result = tag
+                        break
                 else:
                     result = "passed"
-                cases.append(JUnitCase(s.get("name", "unknown"), tc.get("classname", "unknown"),
-                                       tc.get("name", "unknown"), result, tc.get("time", "")))
+                if result == "error":
+                    errors += 1
+                props = {}
+                for pr in tc.iter("property"):
+                    if pr.get("name") is not None:
+                        props.setdefault(pr.get("name"), pr.get("value", pr.text or ""))
+                out = tc.find("system-out")
+                cases.append(JUnitCase(
+                    s.get("name", "unknown"), tc.get("classname", "unknown"),
+                    tc.get("name", "unknown"), result, tc.get("time", ""), props,
+                    message=(outcome.get("message", "") if outcome is not None else ""),
+                    text=((outcome.text or "") if outcome is not None else ""),
+                    system_out=((out.text or "") if out is not None else ""), index=i))
             if cases:
-                suites.append((s.get("name", "unknown"), cases, s is not ts))
-    return JUnitFile(rel, suites, errors)
+                nested = s is not ts
+                suites.append(JUnitSuite(s.get("name", "unknown"), cases, nested,
+                                         None if nested else k))
+    view, why = _reports_view(path)
+    return JUnitFile(rel, suites, errors, view, why)
+
+
+def _reports_view(path: Path):
+    """sphinx-test-reports' own parse of a JUnit file, as its directives will see it, or
+    (None, reason) when its parser cannot read the file (it raises on, for example, a
+    non-numeric ``time`` or ``line`` attribute)."""
+    try:
+        from sphinxcontrib.test_reports.junitparser import JUnitParser
+    except ImportError:
+        return None, "sphinx-test-reports is not installed"
+    try:
+        return JUnitParser(str(path)).parse(), ""
+    except Exception as exc:  # noqa: BLE001 - any failure of the third-party parser
+        return None, f"the JUnit parser of sphinx-test-reports fails on this file ({type(exc).__name__})"
 
 
 def _load_tests(inp: Inputs) -> None:
@@ -427,6 +545,53 @@ def _unit_match(test: str, keys: set, name: str) -> bool:
     return any(test.endswith("/" + k) for k in keys if "::" in k)
 
 
+_RESULT_RANK = {"passed": 0, "skipped": 1, "failure": 2, "error": 3}
+_ASSERT_TAG = re.compile(r"^\s*//+\s*@assert\s+(\S+)\s+(.*?)\s*:\s*(.*?)\s*$")
+_REQ_ID = re.compile(r"\bREQ-[A-Z]+-\d+\b")
+_PROP_SHOWN = {"name", "requirements", "verdict", "states_stored", "depth", "errors", "time_s",
+               "memory_mb", "text", "configuration", "command", "counterexample", "transitions",
+               "incomplete"}
+_MUT_SHOWN = {"name", "expect", "verdict", "property", "text", "counterexample"}
+_CASE_SPLIT = re.compile(r"^(?P<name>[^\[]+)(?:$|\[(?P<param>.*)\]$)", re.DOTALL)
+
+
+def model_assertions(text: str) -> dict:
+    """Named assertions of a Promela model: ``// @assert <label> <REQ ids> : text`` on the
+    line before an ``assert(...)``. Returns {label: {"requirements", "text", "line"}}."""
+    out = {}
+    for n, line in enumerate(text.splitlines(), 1):
+        m = _ASSERT_TAG.match(line)
+        if m and m.group(1) not in out:
+            out[m.group(1)] = {"requirements": _REQ_ID.findall(m.group(2)),
+                               "text": m.group(3), "line": n}
+    return out
+
+
+def _pan_checks_assertions(command: str) -> bool:
+    """pan checks every assert() in every run unless started with -A."""
+    return "-A" not in command.replace("&&", " ").split()
+
+
+def _own_need(kind: str, title: str, fields: dict, note: str, links=(), verifies=(),
+              replays=(), exact=(), blocks=(), style=None) -> str:
+    """The JSON content of an ``rp-test-need`` directive (evidence/_ext): a need of
+    sphinx-test-reports' type ``kind`` built from this module's parse of the XML. JSON with
+    ensure_ascii has no character that could end or re-indent a reStructuredText line, so
+    any test name passes through unchanged."""
+    obj = {"type": kind, "title": title, "fields": fields, "note": note,
+           "links": list(links), "verifies": list(verifies), "replays": list(replays),
+           "exact": [list(e) for e in exact], "blocks": [list(b) for b in blocks if b[1].strip()],
+           "style": style}
+    return json.dumps(obj, ensure_ascii=True, sort_keys=True, indent=1)
+
+
+def _time_text(t: str) -> str:
+    try:
+        return str(float(t)) if t else "0.0"
+    except ValueError:
+        return display_text(t)
+
+
 class Model:
     """Everything the templates show, computed once from the inputs."""
 
@@ -442,6 +607,7 @@ class Model:
         self._vectors()
         self._coverage()
         self._tests()
+        self._conformance()
         self._analysis()
         self._requirement_links()
         self._versions()
@@ -509,6 +675,16 @@ class Model:
             self.problems.append(f"trace.json names {rid}, which is not in the specification")
 
     # -- model checking -------------------------------------------------------------------
+    def _trace_assertions(self, model: str) -> dict:
+        """{label: {requirement ids}} of the ``assert:<label>`` model links in trace.json."""
+        out: dict = {}
+        for rid, r in sorted(self.trace_by_id.items()):
+            for m in (r.get("links") or {}).get("model") or []:
+                if isinstance(m, dict) and str(m.get("property", "")).startswith("assert:") \
+                        and m.get("model", model) == model:
+                    out.setdefault(str(m["property"])[7:], set()).add(rid)
+        return out
+
     def _spin(self):
         self.models = []
         self.prop_by_name = {}
@@ -536,48 +712,129 @@ class Model:
                     self.problems.append(f"model property {p['name']} names unknown requirement {r}")
                 if verdict != "verified":
                     self.problems.append(f"model property {p['name']} ({model}): {verdict}")
-                extra = {k: fmt_value(v) for k, v in p.items()
-                         if k not in ("name", "requirements", "verdict", "states_stored", "depth",
-                                      "errors", "time_s", "memory_mb")}
-                props.append({"id": nid, "name": p["name"], "verdict": verdict,
+                incomplete = p.get("incomplete") or []
+                props.append({"id": nid, "name": p["name"], "kind": "ltl", "verdict": verdict,
+                              "text": str(p.get("text") or ""),
+                              "configuration": str(p.get("configuration") or ""),
                               "states": fmt_value(p.get("states_stored")),
+                              "transitions": fmt_value(p.get("transitions")),
                               "depth": fmt_value(p.get("depth")),
                               "errors": fmt_value(p.get("errors")),
                               "time_s": fmt_value(p.get("time_s")),
                               "memory_mb": fmt_value(p.get("memory_mb")),
-                              "links": links, "unknown": unknown, "extra": sorted(extra.items())})
+                              "command": str(p.get("command") or ""),
+                              "counterexample": str(p.get("counterexample") or ""),
+                              "incomplete": fmt_value(incomplete) if incomplete else "",
+                              "links": links, "unknown": unknown,
+                              "extra": sorted((k, fmt_value(v)) for k, v in p.items()
+                                              if k not in _PROP_SHOWN)})
                 self.prop_by_name.setdefault(p["name"], nid)
                 self.prop_by_name[(model, p["name"])] = nid
+            runs = list(d.get("properties", []))
+            mutant_list = [m for m in d.get("mutants", [])]
+            assertions = self._assertions(model, stem, runs, mutant_list, props)
+            by_name = {p["name"]: p["id"] for p in props + assertions}
             mutants = []
-            for m in d.get("mutants", []):
+            for m in mutant_list:
                 nid = self._readable("MUT", m["name"]) if need_id("MUT", m["name"], upper=False) \
                     not in self.need_ids else self._readable("MUT", stem, m["name"])
                 expect = str(m.get("expect", "rejected"))
                 verdict = str(m["verdict"])
                 if verdict != expect:
                     self.problems.append(f"mutant {m['name']} ({model}): {verdict}, expected {expect}")
-                target = next((p["id"] for p in props if p["name"] == m.get("property")), None)
+                prop = str(m.get("property") or "")
                 mutants.append({"id": nid, "name": m["name"], "expect": expect, "verdict": verdict,
-                                "property": m.get("property") or "", "target": target,
-                                "extra": sorted((k, fmt_value(v)) for k, v in m.items() if k not in
-                                                ("name", "expect", "verdict", "property"))})
+                                "property": prop, "target": by_name.get(prop),
+                                "text": str(m.get("text") or ""),
+                                "counterexample": str(m.get("counterexample") or ""),
+                                "extra": sorted((k, fmt_value(v)) for k, v in m.items()
+                                                if k not in _MUT_SHOWN)})
             bounds = [(str(k), fmt_value(v)) for k, v in (d.get("bounds") or {}).items()]
             other = [(str(k), fmt_value(v)) for k, v in d.items()
                      if k not in ("model", "model_sha256", "spin_version", "bounds", "properties",
                                   "mutants")]
+            source = None
+            if self.inp.model_sources.get(model) is not None:
+                source = f"source/{(self.inp.repo_root / model).resolve().relative_to(self.inp.repo_root.resolve()).as_posix()}"
+            commands = []
+            for p in props:
+                if p["command"] and p["command"] not in commands:
+                    commands.append(p["command"])
             self.models.append({"rel": rel, "stem": stem, "model": model, "sha": sha,
                                 "src_check": src_check, "spin_version": str(d.get("spin_version", "n/a")),
                                 "bounds": bounds, "other": other, "properties": props,
-                                "mutants": mutants,
+                                "assertions": assertions, "mutants": mutants, "source": source,
+                                "commands": commands,
                                 "verified": sum(p["verdict"] == "verified" for p in props),
+                                "assertions_verified": sum(a["verdict"] == "verified" for a in assertions),
                                 "rejected": sum(m["verdict"] == m["expect"] for m in mutants)})
             if src_check.startswith("DIFFERS"):
                 self.problems.append(f"{model}: model hash in {rel} differs from the source tree")
+
+    def _assertions(self, model: str, stem: str, runs: list, mutants: list, props: list) -> list:
+        """Needs for the model's named assertions (``assert:<label>``) that the result file
+        does not list as properties of their own. pan checks every assert() of the model
+        in every verification run (unless started with -A), so an assertion is verified
+        when every run of the model completed without an error."""
+        src = self.inp.model_sources.get(model)
+        annotated = model_assertions(src) if src else {}
+        from_trace = self._trace_assertions(model)
+        named = set(annotated) | set(from_trace)
+        named |= {str(m.get("property"))[7:] for m in mutants
+                  if str(m.get("property") or "").startswith("assert:")}
+        listed = {p["name"][7:] for p in props if p["name"].startswith("assert:")}
+        checking = [p for p in runs if _pan_checks_assertions(str(p.get("command") or ""))]
+        out = []
+        for label in sorted(named - listed):
+            name = f"assert:{label}"
+            ann = annotated.get(label)
+            reqs = list(ann["requirements"]) if ann else sorted(from_trace.get(label, ()))
+            killers = [m["name"] for m in mutants if m.get("property") == name
+                       and m.get("verdict") == m.get("expect", "rejected") == "rejected"]
+            bad = [p for p in checking
+                   if str(p.get("verdict")) != "verified" or (p.get("errors") or 0) != 0]
+            configs = sorted({str(p.get("configuration") or "default") for p in checking})
+            if not checking:
+                verdict = "not checked"
+                basis = ("the result file lists no verification run of this model that checks "
+                         "assertions")
+            elif bad:
+                verdict = "not established"
+                basis = (f"{len(bad)} of the {len(checking)} verification runs of this model did "
+                         f"not complete without an error (first: {bad[0].get('name')})")
+            else:
+                verdict = "verified"
+                basis = (f"pan checks every assert() of the model in every run not started with "
+                         f"-A; all {len(checking)} verification runs of this model "
+                         f"(configurations: {', '.join(configs)}) searched their whole state "
+                         "space without an error")
+            if killers:
+                basis += (f"; mutant {', '.join(killers)}, which breaks this assertion, was "
+                          "rejected by a run of the same kind, so the check is active")
+            nid = self._readable("ASSERT", label) if need_id("ASSERT", label, upper=False) \
+                not in self.need_ids else self._readable("ASSERT", stem, label)
+            for r in reqs:
+                if r not in self.req_ids:
+                    self.problems.append(f"model assertion {label} names unknown requirement {r}")
+            if verdict != "verified":
+                self.problems.append(f"model assertion {label} ({model}): {verdict}")
+            origin = (f"annotated in {model} line {ann['line']}" if ann else
+                      "named by a mutant or by trace.json; the model source is not in this package")
+            out.append({"id": nid, "name": name, "label": label, "kind": "assertion",
+                        "verdict": verdict, "text": ann["text"] if ann else "", "basis": basis,
+                        "states": f"in {len(checking)} runs" if checking else "n/a",
+                        "origin": origin, "runs": len(checking), "configurations": ", ".join(configs),
+                        "links": [r for r in reqs if r in self.req_ids],
+                        "unknown": [r for r in reqs if r not in self.req_ids]})
+            self.prop_by_name.setdefault(name, nid)
+            self.prop_by_name[(model, name)] = nid
+        return out
 
     # -- vectors --------------------------------------------------------------------------
     def _vectors(self):
         self.vector_files = []
         self.vector_by_id = {}
+        self.vector_items = {}     # need id -> item
         for rel, header, vectors in self.inp.vectors:
             stem = Path(rel).name[:-len(".jsonl")]
             by_req: dict = {}
@@ -586,15 +843,25 @@ class Model:
                 nid = self._claim(need_id(v["id"], upper=False), f"vector {v['id']}")
                 reqs = [str(r) for r in v.get("requirements") or []]
                 steps = v.get("steps") or []
-                item = {"id": nid, "orig": v["id"], "goal": str(v.get("goal", "")),
-                        "title": str(v.get("goal") or v["id"]),
+                if v.get("goal"):
+                    title = str(v["goal"])
+                elif v.get("seed") is not None:
+                    title = f"{v.get('kind') or 'random'} walk, seed {fmt_value(v['seed'])}"
+                else:
+                    title = str(v["id"])
+                item = {"id": nid, "orig": v["id"], "goal": str(v.get("goal") or ""),
+                        "title": title,
+                        "kind": str(v.get("kind") or ""), "role": str(v.get("role") or ""),
                         "links": [r for r in reqs if r in self.req_ids],
                         "unknown": [r for r in reqs if r not in self.req_ids],
                         "nsteps": len(steps), "steps": [safe_json_line(s) for s in steps],
+                        "conformance": "not replayed", "cases": [],
                         "extra": sorted((k, fmt_value(x)) for k, x in v.items()
-                                        if k not in ("id", "requirements", "goal", "steps"))}
+                                        if k not in ("id", "requirements", "goal", "steps",
+                                                     "kind", "role"))}
                 items.append(item)
                 self.vector_by_id[v["id"]] = nid
+                self.vector_items[nid] = item
                 home = reqs[0] if reqs else "(no requirement)"
                 by_req.setdefault(home, []).append(item)
                 for r in item["unknown"]:
@@ -607,7 +874,7 @@ class Model:
                    if k not in ("kind", "parameters", "unit_scales")]
             self.vector_files.append({
                 "rel": rel, "stem": stem, "page": f"vectors_{need_id(stem).lower()}",
-                "header": hdr,
+                "header": hdr, "items": items,
                 "unit_scales": [(k, fmt_value(x)) for k, x in (header.get("unit_scales") or {}).items()],
                 "parameters": [(k, fmt_value(x)) for k, x in (header.get("parameters") or {}).items()],
                 "count": len(items), "steps": sum(i["nsteps"] for i in items),
@@ -618,21 +885,44 @@ class Model:
 
     def _coverage(self):
         self.coverage = []
+        self.goals_by_req: dict = {}
         for rel, d in self.inp.coverage:
             goals = []
             for g in d["goals"]:
                 status = str(g["status"])
-                vec = g.get("vector")
+                vecs = g.get("vectors")
+                if vecs is None:          # older format: one "vector" per goal
+                    vecs = [g["vector"]] if g.get("vector") else []
+                elif not isinstance(vecs, list):
+                    vecs = [vecs]
+                vecs = [str(v) for v in vecs if v]
                 just = g.get("justification")
-                ok = (status == "reached" and vec) or (status == "unreachable" and just)
+                ok = (status == "reached" and vecs) or (status == "unreachable" and just)
                 if not ok:
                     self.problems.append(f"goal {g['id']} ({rel}): {status} without "
                                          f"{'vector' if status == 'reached' else 'justification'}")
-                goals.append({"id": str(g["id"]), "label": str(g.get("label", "")),
-                              "requirements": ", ".join(g.get("requirements") or []),
-                              "status": status, "vector": vec,
-                              "vector_need": self.vector_by_id.get(vec) if vec else None,
-                              "justification": just or ""})
+                for v in vecs:
+                    if v not in self.vector_by_id:
+                        self.problems.append(f"goal {g['id']} ({rel}) names vector {v}, which is "
+                                             "not in the vector files")
+                jentry = self.inp.justifications.get(str(just)) if just else None
+                reqs = [str(r) for r in g.get("requirements") or []]
+                goal = {"id": str(g["id"]), "label": str(g.get("label", "")),
+                        "requirements": ", ".join(reqs), "reqs": reqs,
+                        "status": status, "vectors": vecs,
+                        "vector_needs": [self.vector_by_id[v] for v in vecs if v in self.vector_by_id],
+                        "justification": str(just) if just else "",
+                        "justification_text": " ".join(str(jentry.get("text", "")).split())
+                        if jentry else "",
+                        "states_searched": fmt_value(g["states_searched"])
+                        if g.get("states_searched") is not None else "",
+                        "rel": rel}
+                goals.append(goal)
+                for nid in goal["vector_needs"]:
+                    if goal["label"]:
+                        self.vector_items[nid]["title"] = f"{goal['id']}: {goal['label']}"
+                for r in reqs:
+                    self.goals_by_req.setdefault(r, []).append(goal)
             reached = d.get("reached", sum(g["status"] == "reached" for g in goals))
             labelled = d.get("labelled", len(goals))
             extra = [(k, fmt_value(v)) for k, v in d.items() if k not in ("goals", "reached", "labelled")]
@@ -641,6 +931,65 @@ class Model:
                                   "extra": extra})
 
     # -- tests ----------------------------------------------------------------------------
+    @staticmethod
+    def _suite_why(jf: JUnitFile, s: JUnitSuite, file_why: str) -> str:
+        """Why sphinx-test-reports cannot render this suite's need exactly ("" if it can):
+        its test-suite directive takes the first top-level suite of that name, and its
+        test-case directive searches that suite's cases."""
+        if file_why:
+            return file_why
+        if s.nested:
+            return "a nested suite (sphinx-test-reports 1.3.1 looks suites up at the top level only)"
+        if not plain_option(s.name):
+            return ("its suite name cannot be passed unchanged to sphinx-test-reports as a "
+                    "one-line directive option")
+        view = jf.reports_view or []
+        first = next((j for j, v in enumerate(view) if v.get("name") == s.name), None)
+        if first != s.top_index:
+            return "an earlier top-level suite of the file has the same name"
+        theirs = [(c.get("classname"), c.get("name")) for c in view[first].get("testcases", [])]
+        if theirs != [(c.classname, c.name) for c in s.cases]:
+            return "sphinx-test-reports reads a different list of cases for this suite"
+        return ""
+
+    @staticmethod
+    def _case_why(suite_why: str, vcases: list, c: JUnitCase) -> str:
+        """Why sphinx-test-reports cannot render this case exactly ("" if it can)."""
+        if suite_why:
+            return suite_why
+        if not (plain_option(c.name) and plain_option(c.classname)):
+            return ("its name cannot be passed unchanged to sphinx-test-reports as a one-line "
+                    "directive option")
+        first = next((j for j, v in enumerate(vcases)
+                      if v.get("name") == c.name and v.get("classname") == c.classname), None)
+        if first != c.index:
+            return ("an earlier case of the suite has the same class and name (sphinx-test-reports "
+                    "would show that one)")
+        theirs = vcases[c.index]
+        if theirs.get("result") != c.result:
+            return (f"sphinx-test-reports 1.3.1 would show it as {theirs.get('result')} "
+                    f"(it does not read a JUnit <{c.result}> element)")
+        for key in ("text", "message", "system-out"):
+            t = theirs.get(key)
+            if t and not t.strip():
+                return f"its {key} is blank (sphinx-test-reports would emit an empty literal block)"
+        return ""
+
+    def _replayed(self, c: JUnitCase, title: str, rel: str, vec_tokens: list) -> list:
+        """The vector needs a test case replays: its ``vector_id`` property (written by the
+        conformance runner) or, for runners that write none, the vector id spelled inside
+        the test name (``TG-TRAP-017`` in ``Replays/TG_TRAP_017``)."""
+        vid = c.properties.get("vector_id")
+        if vid is not None:
+            nid = self.vector_by_id.get(vid)
+            if nid is None:
+                self.problems.append(f"test {title} ({rel}) replays vector {vid}, which is not in "
+                                     "the vector files")
+                return []
+            return [nid]
+        toks = _tokens(f"{c.classname} {c.name}")
+        return sorted({nid for vt, nid in vec_tokens if _contains_seq(toks, vt)})
+
     def _tests(self):
         unit_map = []   # (test string, requirement)
         for rid, r in self.trace_by_id.items():
@@ -649,35 +998,129 @@ class Model:
                     unit_map.append((str(u["test"]), rid))
         vec_tokens = [(_tokens(vid), nid) for vid, nid in self.vector_by_id.items()]
         self.case_by_test = {}
+        self.replays_by_vector: dict = {}
         self.test_files = []
+        self.own_rendered = 0
         totals = {"passed": 0, "failure": 0, "error": 0, "skipped": 0}
         for jf in self.inp.junit:
             fid = self._readable("TF", jf.rel.removeprefix("tests/").removesuffix(".xml"))
+            if jf.reports_view is None:
+                file_why = jf.reports_error
+            elif not plain_option(jf.rel):
+                file_why = ("its path cannot be passed unchanged to sphinx-test-reports as a "
+                            "one-line directive option")
+            else:
+                file_why = ""
             suites = []
             counts = {"passed": 0, "failure": 0, "error": 0, "skipped": 0}
-            for sname, cases, nested in jf.suites:
-                sid = self._readable("TS", sname)
+            for s in jf.suites:
+                sid = self._readable("TS", s.name)
+                s_why = self._suite_why(jf, s, file_why)
+                vcases = [] if s_why else (jf.reports_view or [])[s.top_index].get("testcases", [])
+                scounts = {"passed": 0, "failure": 0, "error": 0, "skipped": 0}
                 items = []
-                for c in cases:
+                for c in s.cases:
                     cid = self._readable("TC", c.classname, c.name)
+                    title = display_text(f"{c.classname}.{c.name}")
                     keys = _case_keys(c)
                     reqs = sorted({rid for test, rid in unit_map if _unit_match(test, keys, c.name)})
-                    toks = _tokens(f"{c.classname} {c.name}")
-                    vecs = sorted({nid for vt, nid in vec_tokens if _contains_seq(toks, vt)})
+                    vecs = self._replayed(c, title, jf.rel, vec_tokens)
                     counts[c.result] += 1
+                    scounts[c.result] += 1
                     if c.result in ("failure", "error"):
-                        self.problems.append(f"test {c.classname}.{c.name} ({jf.rel}): {c.result}")
-                    items.append({"id": cid, "suite": sname, "classname": c.classname, "name": c.name,
-                                  "result": c.result, "verifies": reqs, "vectors": vecs})
+                        self.problems.append(f"test {title} ({jf.rel}): {c.result}")
+                    for v in vecs:
+                        self.replays_by_vector.setdefault(v, []).append((cid, c.result))
+                    why = self._case_why(s_why, vcases, c)
+                    item = {"id": cid, "suite": s.name, "classname": c.classname, "name": c.name,
+                            "title": title, "result": c.result, "verifies": reqs, "vectors": vecs,
+                            "own": ""}
+                    if why:
+                        self.own_rendered += 1
+                        m = _CASE_SPLIT.match(c.name)
+                        exact = [(k, v) for k, v in (("name", c.name), ("classname", c.classname),
+                                                     ("suite", s.name))
+                                 if display_text(v) != v]
+                        item["own"] = _own_need(
+                            "testcase", title,
+                            {"file": display_text(jf.rel), "suite": display_text(s.name),
+                             "case": display_text(c.name),
+                             "case_name": display_text(m.group("name") if m else c.name),
+                             "case_parameter": display_text(m.group("param") or "") if m else "",
+                             "classname": display_text(c.classname), "result": c.result,
+                             "time": _time_text(c.time)},
+                            f"Rendered from the JUnit XML by the evidence build, not by "
+                            f"sphinx-test-reports: {why}.",
+                            links=[sid], verifies=reqs, replays=vecs, exact=exact,
+                            blocks=[("Message", c.message), ("Text", c.text),
+                                    ("System-out", c.system_out)],
+                            style=f"tr_{c.result}")
+                    items.append(item)
                     for k in keys | {c.name}:
                         self.case_by_test.setdefault(k, cid)
-                suites.append({"id": sid, "name": sname, "cases": items, "nested": nested})
+                sitem = {"id": sid, "name": s.name, "title": display_text(s.name), "cases": items,
+                         "nested": s.nested, "own": ""}
+                if s_why:
+                    sitem["own"] = _own_need(
+                        "testsuite", display_text(s.name),
+                        {"file": display_text(jf.rel), "suite": display_text(s.name),
+                         "cases": len(items), "passed": scounts["passed"],
+                         "skipped": scounts["skipped"], "failed": scounts["failure"],
+                         "errors": scounts["error"]},
+                        f"Rendered from the JUnit XML by the evidence build, not by "
+                        f"sphinx-test-reports: {s_why}.", links=[fid],
+                        exact=[("suite", s.name)] if display_text(s.name) != s.name else [])
+                suites.append(sitem)
             for k in totals:
                 totals[k] += counts[k]
-            self.test_files.append({"id": fid, "rel": jf.rel, "suites": suites, "counts": counts,
-                                    "cases": sum(len(s["cases"]) for s in suites),
-                                    "error_elements": jf.error_elements})
+            ncases = sum(len(s["cases"]) for s in suites)
+            fitem = {"id": fid, "rel": jf.rel, "suites": suites, "counts": counts,
+                     "cases": ncases, "error_elements": jf.error_elements, "own": ""}
+            if file_why:
+                fitem["own"] = _own_need(
+                    "testfile", display_text(jf.rel),
+                    {"file": display_text(jf.rel), "suites": len(suites), "cases": ncases,
+                     "passed": counts["passed"], "skipped": counts["skipped"],
+                     "failed": counts["failure"], "errors": counts["error"]},
+                    f"Rendered from the JUnit XML by the evidence build, not by "
+                    f"sphinx-test-reports: {file_why}.")
+            self.test_files.append(fitem)
         self.test_totals = totals
+
+    def _conformance(self):
+        """Each vector's replay result: the worst result of the test cases replaying it."""
+        stats = {"vectors": 0, "passed": 0, "failed": 0, "skipped": 0, "not_replayed": 0}
+        missing, skipped = [], []
+        for nid, item in self.vector_items.items():
+            rs = self.replays_by_vector.get(nid, [])
+            item["cases"] = [cid for cid, _ in rs]
+            stats["vectors"] += 1
+            if not rs:
+                item["conformance"] = "not replayed"
+                stats["not_replayed"] += 1
+                missing.append(item["orig"])
+                continue
+            worst = max((r for _, r in rs), key=lambda r: _RESULT_RANK.get(r, 3))
+            item["conformance"] = worst
+            if worst == "passed":
+                stats["passed"] += 1
+            elif worst == "skipped":
+                stats["skipped"] += 1
+                skipped.append(item["orig"])
+            else:
+                stats["failed"] += 1
+        self.conformance = stats
+        if not self.vector_items or not self.inp.junit:
+            return
+        if not self.replays_by_vector:
+            self.incomplete.append("conformance results: no JUnit test case replays a vector")
+            return
+        if missing:
+            self.problems.append(f"{len(missing)} vector(s) not replayed by any conformance test "
+                                 f"case (first: {missing[0]})")
+        if skipped:
+            self.problems.append(f"{len(skipped)} vector(s) whose conformance test case was "
+                                 f"skipped (first: {skipped[0]})")
 
     # -- analysis -------------------------------------------------------------------------
     def _analysis(self):
@@ -723,6 +1166,8 @@ class Model:
         self.requirements = []
         self.areas = []
         by_file: dict = {}
+        all_props = [p for mo in self.models for p in mo["properties"] + mo["assertions"]]
+        all_mutants = [mu for mo in self.models for mu in mo["mutants"]]
         for r in self.inp.requirements:
             rid = r["id"]
             self._claim(rid, "requirement")
@@ -737,10 +1182,10 @@ class Model:
             model = []
             for m in links.get("model") or []:
                 if isinstance(m, dict):
-                    name = m.get("property", "")
+                    name = str(m.get("property", ""))
                     nid = self.prop_by_name.get((m.get("model"), name)) or self.prop_by_name.get(name)
-                    model.append({"name": name, "verdict": m.get("verdict", ""), "need": nid,
-                                  "model": m.get("model", "")})
+                    model.append({"name": name, "verdict": str(m.get("verdict", "")), "need": nid,
+                                  "model": str(m.get("model", ""))})
             vecs = [str(v) for v in links.get("vectors") or []]
             unit = []
             for u in links.get("unit") or []:
@@ -758,8 +1203,19 @@ class Model:
             src = [str(s) for s in r.get("source") or []]
             asms = sorted({m for s in src for m in re.findall(r"ASM(?:-[A-Z]+)?-\d+", s)}
                           | {m for m in re.findall(r"ASM(?:-[A-Z]+)?-\d+", str(r.get("text", "")))})
+            # evidence resolved from the results themselves (the tables of the page)
+            props = [p for p in all_props if rid in p["links"]]
+            prop_ids = {p["id"] for p in props}
+            mutants = [mu for mu in all_mutants if mu["target"] in prop_ids]
+            vitems = [it for it in self.vector_items.values() if rid in it["links"]]
+            vstat = {"total": len(vitems),
+                     "passed": sum(it["conformance"] == "passed" for it in vitems),
+                     "failed": sum(it["conformance"] in ("failure", "error") for it in vitems),
+                     "skipped": sum(it["conformance"] == "skipped" for it in vitems),
+                     "not_replayed": sum(it["conformance"] == "not replayed" for it in vitems)}
             item = {
                 "id": rid, "title": r.get("title", rid), "text": r.get("text", ""),
+                "page": f"requirements/{rid}",
                 "sil": fmt_value(r.get("sil")), "source": "; ".join(src),
                 "verification": ", ".join(map(str, r.get("verification") or [])),
                 "defence": r.get("defence", ""), "threat": r.get("threat", ""),
@@ -767,9 +1223,14 @@ class Model:
                 "hazards_unknown": [h for h in r.get("hazards") or [] if h not in self.hazard_ids],
                 "assumptions": [a for a in asms if a in self.asm_ids],
                 "status": status, "problems": problems, "counts": counts,
-                "model": model, "goals": goals,
+                "model": model, "model_unresolved": [m for m in model if not m["need"]],
+                "props": props, "mutants": mutants, "goals": goals,
+                "goal_rows": self.goals_by_req.get(rid, []),
                 "vectors": [{"id": v, "need": self.vector_by_id.get(v)} for v in vecs],
-                "unit": unit, "code": code, "analysis": analysis, "proof": proof,
+                "vectors_unresolved": [v for v in vecs if v not in self.vector_by_id],
+                "vector_stats": vstat,
+                "unit": unit, "unit_missing": [u for u in unit if not u["need"]],
+                "code": code, "analysis": analysis, "proof": proof,
             }
             self.requirements.append(item)
             by_file.setdefault((r["_file"], r.get("_area", "")), []).append(item)
@@ -814,6 +1275,8 @@ class Model:
             "hazards": len(self.hazards), "assumptions": len(self.assumptions),
             "models": len(self.models), "properties": nprops,
             "properties_verified": sum(m["verified"] for m in self.models),
+            "assertions": sum(len(m["assertions"]) for m in self.models),
+            "assertions_verified": sum(m["assertions_verified"] for m in self.models),
             "mutants": nmut, "mutants_rejected": sum(m["rejected"] for m in self.models),
             "vector_files": len(self.vector_files),
             "vectors": sum(f["count"] for f in self.vector_files),
@@ -825,6 +1288,10 @@ class Model:
             "test_cases": sum(f["cases"] for f in self.test_files),
             "tests_passed": self.test_totals["passed"], "tests_failed": self.test_totals["failure"],
             "tests_errors": self.test_totals["error"], "tests_skipped": self.test_totals["skipped"],
+            "tests_rendered_from_xml": self.own_rendered,
+            "vectors_replayed_passed": self.conformance["passed"],
+            "vectors_replay_failed": self.conformance["failed"],
+            "vectors_not_replayed": self.conformance["not_replayed"] + self.conformance["skipped"],
             "analyses": len(self.analyses),
             "analyses_pass": sum(a["outcome"] == "pass" for a in self.analyses),
         }
@@ -873,8 +1340,11 @@ def render_sources(model: Model, evidence_dir: Path, src_dir: Path) -> list:
     for vf in model.vector_files:
         _write(src_dir / f"{vf['page']}.rst",
                env.get_template("vectors.rst.jinja").render(vf=vf, **ctx))
+    req_tpl = env.get_template("requirement.rst.jinja")
+    for r in model.requirements:
+        _write(src_dir / f"{r['page']}.rst", req_tpl.render(r=r, **ctx))
     _write(src_dir / "replay_commands.inc", env.get_template("replay_commands.inc.jinja").render(**ctx))
-    return pages + [vf["page"] for vf in model.vector_files]
+    return pages + [vf["page"] for vf in model.vector_files] + [r["page"] for r in model.requirements]
 
 
 def copy_inputs(inp: Inputs, inputs_dir: Path) -> list:

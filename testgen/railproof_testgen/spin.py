@@ -27,6 +27,7 @@ _PROP = re.compile(r"^\s*//\s*@property\s+(\w+)\s+((?:REQ-[A-Z]{2}-\d{3}\s*)+):\
 _GOAL = re.compile(r"^\s*//\s*@goal\s+(\d+)\s+((?:REQ-[A-Z]{2}-\d{3}\s*)+):\s*(.*)$")
 _MUT = re.compile(r"^\s*//\s*@mutant\s+(\w+)\s+violates\s+(\S+)\s*:\s*(.*)$")
 _ASSERT = re.compile(r"^\s*//\s*@assert\s+(\w+)\s+((?:REQ-[A-Z]{2}-\d{3}\s*)+):\s*(.*)$")
+_VARIANT = re.compile(r"^\s*//\s*@variant\s+(\w+)\s+(\w+)=(\w+)\s*:\s*(.*)$")
 _CONFIG = re.compile(r"\[config\s+(\w+)\]")
 
 PAN_FLAGS = ["-O2", "-DSAFETY", "-DBFS", "-DMEMLIM=8000"]
@@ -59,12 +60,21 @@ class Mutant:
 
 
 @dataclass
+class Variant:
+    define: str
+    parameter: str  # vector header parameter it overrides
+    bound: str      # model bound (lower-case name without MODEL_) giving the new value
+    text: str
+
+
+@dataclass
 class Annotations:
     model: Path
     properties: list = field(default_factory=list)
     goals: list = field(default_factory=list)
     mutants: list = field(default_factory=list)
-    asserts: dict = field(default_factory=dict)  # label -> (expression without spaces, requirements, text)
+    asserts: dict = field(default_factory=dict)
+    variants: list = field(default_factory=list)  # label -> (expression without spaces, requirements, text)
 
 
 def _squash(expr: str) -> frozenset:
@@ -78,6 +88,10 @@ def parse_annotations(model: Path) -> Annotations:
     seen = set()
     lines = model.read_text(encoding="utf-8").splitlines()
     for lineno, line in enumerate(lines, 1):
+        m = _VARIANT.match(line)
+        if m:
+            ann.variants.append(Variant(m.group(1), m.group(2), m.group(3), m.group(4).strip()))
+            continue
         m = _ASSERT.match(line)
         if m:
             nxt = lines[lineno] if lineno < len(lines) else ""
@@ -209,7 +223,10 @@ def verify(model: Path, params_dir: Path, workdir: Path, out_json: Path, jobs: i
     ann = parse_annotations(model)
     version = spin_version()
     bounds = read_bounds(next(Path(params_dir).glob(f"{model.stem}_params.pml")))
-    configs = sorted({p.config for p in ann.properties}, key=lambda c: c or "")
+    # every default-configuration property is also verified in every boundary variant
+    runs = [(p, p.config) for p in ann.properties]
+    runs += [(p, v.define) for v in ann.variants for p in ann.properties if p.config is None]
+    configs = sorted({c for _, c in runs}, key=lambda c: c or "")
     t0 = time.monotonic()
     dirs = {}
     for cfg in configs:
@@ -217,12 +234,13 @@ def verify(model: Path, params_dir: Path, workdir: Path, out_json: Path, jobs: i
         _progress(f"compiling {model.name} [{name}]")
         dirs[cfg] = prepare(model, params_dir, Path(workdir) / f"verify-{name}", [cfg] if cfg else [])
 
-    def run_prop(p: Property):
+    def run_prop(run):
+        p, config = run
         # each property in its own copy of the binary's directory: pan writes the trail there
-        wd = Path(workdir) / f"prop-{p.name}"
+        wd = Path(workdir) / f"prop-{p.name}-{config or 'default'}"
         if wd.exists():
             shutil.rmtree(wd)
-        shutil.copytree(dirs[p.config], wd)
+        shutil.copytree(dirs[config], wd)
         r = _run(["./pan", "-N", p.name], wd)
         res = parse_pan(r.stdout + r.stderr)
         if res["errors"] is None:
@@ -231,19 +249,21 @@ def verify(model: Path, params_dir: Path, workdir: Path, out_json: Path, jobs: i
         cex = None
         if res["errors"]:
             verdict = "violated"
-            cex = counterexample(wd, model.name, [p.config] if p.config else [])
+            cex = counterexample(wd, model.name, [config] if config else [])
         elif res["incomplete"]:
             verdict = "incomplete"
-        _progress(f"{p.name}: {verdict} ({res['states_stored']} states, depth {res['depth']}, {res['time_s']} s)")
+        _progress(f"{p.name} [{config or 'default'}]: {verdict} ({res['states_stored']} states, "
+                  f"depth {res['depth']}, {res['time_s']} s)")
         return {"name": p.name, "requirements": p.requirements, "text": p.text,
-                "configuration": p.config or "default", "verdict": verdict,
-                "command": f"spin {'-D' + p.config + ' ' if p.config else ''}-a {model.name} && "
+                "configuration": config or "default", "verdict": verdict,
+                "command": f"spin {'-D' + config + ' ' if config else ''}-a {model.name} && "
                            f"cc {' '.join(PAN_FLAGS)} -o pan pan.c && ./pan -N {p.name}",
                 "counterexample": cex, **{k: v for k, v in res.items() if k != "violated_expression"}}
 
-    _progress(f"verifying {len(ann.properties)} properties with {jobs} job(s)")
+    _progress(f"verifying {len(ann.properties)} properties in {len(configs)} configuration(s): "
+              f"{len(runs)} runs with {jobs} job(s)")
     with ThreadPoolExecutor(max_workers=max(1, jobs)) as ex:
-        props = list(ex.map(run_prop, ann.properties))
+        props = list(ex.map(run_prop, runs))
 
     def run_mutant(mu: Mutant):
         wd = prepare(model, params_dir, Path(workdir) / f"mutant-{mu.name}", [mu.name])
@@ -276,6 +296,8 @@ def verify(model: Path, params_dir: Path, workdir: Path, out_json: Path, jobs: i
         "pan_flags": PAN_FLAGS,
         "bounds": bounds,
         "properties": props,
+        "variants": [{"define": v.define, "parameter": v.parameter, "bound": v.bound, "text": v.text}
+                     for v in ann.variants],
         "mutants": mutants,
         "wall_time_s": round(time.monotonic() - t0, 1),
     }
@@ -290,7 +312,7 @@ def verify(model: Path, params_dir: Path, workdir: Path, out_json: Path, jobs: i
     if failures or survivors:
         msg = []
         for p in failures:
-            msg.append(f"property {p['name']} ({', '.join(p['requirements'])}) {p['verdict']}"
+            msg.append(f"property {p['name']} ({', '.join(p['requirements'])}) [{p['configuration']}] {p['verdict']}"
                        + (f": {'; '.join(p['incomplete'])}" if p["incomplete"] else "")
                        + (f"\ncounterexample:\n{p['counterexample']}" if p["counterexample"] else ""))
         for m in survivors:

@@ -204,6 +204,41 @@ def generate(model: Path, params_dir: Path, spec_dir: Path, workdir: Path, out_d
         coverage.append({"id": g.gid, "label": g.label, "requirements": g.requirements, "status": status,
                          "vectors": vec_ids, "justification": just if status == "unreachable" else None,
                          "states_searched": res["states_stored"] if status == "unreachable" else None})
+    # Boundary variants: goals unreachable in the main configuration are searched again in
+    # each variant; a goal reached there yields vectors in a file of its own, whose header
+    # carries the variant's parameter.
+    variant_files = {}
+    unreachable = [g for g, status, _, _ in outcomes if status == "unreachable"]
+    for v in ann.variants if unreachable else []:
+        _progress(f"variant {v.define}: searching {len(unreachable)} goal(s) unreachable in the main configuration")
+        vbase = spin_mod.prepare(model, params_dir, workdir / f"traps-{v.define}", ["TRAPS", v.define], [goals_file])
+        vvecs = []
+        for g in unreachable:
+            wd = workdir / f"goal{g.number}-{v.define}"
+            if wd.exists():
+                shutil.rmtree(wd)
+            shutil.copytree(vbase, wd)
+            r = spin_mod._run(["./pan", "-N", f"goal{g.number}"], wd)
+            res = spin_mod.parse_pan(r.stdout + r.stderr)
+            if not res["errors"]:
+                _progress(f"{g.gid} unreachable in {v.define} too")
+                continue
+            rep = spin_mod._run(["spin", "-DTRAPS", f"-D{v.define}", "-t", model.name], wd, timeout=300)
+            events = parse_events(rep.stdout)
+            reqs = sorted(set(g.requirements) | observed_requirements(events))
+            suffix = v.define.lower().replace("variant_", "").replace("_", "")
+            for role in ("ground", "train"):
+                vvecs.append({"id": f"TG-BOUNDARY-{g.gid}{suffix}-{role}", "role": role, "requirements": reqs,
+                              "goal": g.gid, "kind": "boundary", "seed": None,
+                              "steps": to_steps(events, role, ids)})
+            cov_entry = next(c for c in coverage if c["id"] == g.gid)
+            cov_entry.setdefault("variant_vectors", []).extend(x["id"] for x in vvecs[-2:])
+            cov_entry["variant"] = v.define
+            _progress(f"{g.gid} reached in variant {v.define} in {len(events)} steps")
+        if vvecs:
+            if v.bound not in bounds:
+                raise SpecError(model, v.define, f"variant names unknown model bound {v.bound}")
+            variant_files[v.define.lower()] = (v, vvecs)
     for gid in sorted(set(justifications) - {c["id"] for c in coverage if c["status"] == "unreachable"}):
         problems.append(f"justification {justifications[gid]} names goal {gid}, which is reached or unknown")
 
@@ -252,6 +287,7 @@ def generate(model: Path, params_dir: Path, spec_dir: Path, workdir: Path, out_d
                                 "steps": to_steps(events, role, ids)})
 
     header = {
+        # the main configuration header (variants override one parameter)
         "kind": "header", "schema_version": 1, "model": model_rel,
         "model_sha256": spin_mod.sha256_file(model),
         "generator": f"railproof_testgen {__version__}", "spin_version": spin_mod.spin_version(),
@@ -267,23 +303,35 @@ def generate(model: Path, params_dir: Path, spec_dir: Path, workdir: Path, out_d
     }
     schema = json.loads((Path(spec_dir) / "schemas" / "vectors.schema.json").read_text(encoding="utf-8"))
     validator = jsonschema.Draft202012Validator(schema)
-    lines = [header, *vectors]
-    for n, obj in enumerate(lines, 1):
-        err = next(iter(validator.iter_errors(obj)), None)
-        if err:
-            raise PipelineError(f"generated vector line {n} violates the vector schema: "
-                                f"{'/'.join(map(str, err.path))}: {err.message}")
+
+    def checked(lines, name):
+        for n, obj in enumerate(lines, 1):
+            err = next(iter(validator.iter_errors(obj)), None)
+            if err:
+                raise PipelineError(f"generated {name} line {n} violates the vector schema: "
+                                    f"{'/'.join(map(str, err.path))}: {err.message}")
+        return "".join(json.dumps(o, sort_keys=True, separators=(",", ":")) + "\n" for o in lines)
+
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
+    for old in out_dir.glob(f"{model.stem}.*.jsonl"):
+        old.unlink()  # variant files of an earlier run
+    for suffix, (v, vvecs) in sorted(variant_files.items()):
+        vheader = json.loads(json.dumps(header))
+        vheader["parameters"][v.parameter] = bounds[v.bound]
+        vheader["variant"] = v.define
+        name = f"{model.stem}.{suffix}.jsonl"
+        _atomic_write(out_dir / name, checked([vheader, *vvecs], name))
+    lines = [header, *vectors]
     reached = sum(1 for c in coverage if c["status"] == "reached")
     cov = {"schema": "railproof/coverage/1", "model": model_rel, "goals": coverage, "reached": reached,
            "labelled": len(coverage), "unreachable_justified": sum(
                1 for c in coverage if c["status"] == "unreachable" and c["justification"]),
            "vectors": {"trap": sum(v["kind"] == "trap" for v in vectors),
                        "boundary": sum(v["kind"] == "boundary" for v in vectors),
-                       "random": sum(v["kind"] == "random" for v in vectors)}}
-    _atomic_write(out_dir / f"{model.stem}.jsonl",
-                  "".join(json.dumps(o, sort_keys=True, separators=(",", ":")) + "\n" for o in lines))
+                       "random": sum(v["kind"] == "random" for v in vectors),
+                       "variant_boundary": sum(len(vv) for _, vv in variant_files.values())}}
+    _atomic_write(out_dir / f"{model.stem}.jsonl", checked(lines, f"{model.stem}.jsonl"))
     _atomic_write(out_dir / f"{model.stem}.coverage.json", json.dumps(cov, indent=2, sort_keys=True) + "\n")
     _progress(f"goal coverage {reached}/{len(coverage)} reached, "
               f"{cov['unreachable_justified']} unreachable justified; {len(vectors)} vectors written")

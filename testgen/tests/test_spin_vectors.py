@@ -79,7 +79,7 @@ def test_verify_fails_with_the_counterexample_on_a_violated_property(tmp_path):
     with pytest.raises(PipelineError) as exc:
         spin.verify(FIX / "tiny.pml", FIX, tmp_path / "work", tmp_path / "out.json", jobs=1)
     msg = str(exc.value)
-    assert "P_BELOW (REQ-TG-008) violated" in msg
+    assert "P_BELOW (REQ-TG-008) [default] violated" in msg
     assert "@OUT tx seq=" in msg  # the replayed counterexample is shown
     import json
     res = json.loads((tmp_path / "out.json").read_text())
