@@ -12,7 +12,7 @@
    one page per requirement with its properties, vectors, conformance and unit results,
    and the JUnit results through sphinx-test-reports (a test whose name or result
    sphinx-test-reports cannot address exactly is rendered from this module's own parse of
-   the XML as a need of the same type, see ``_reports_plan``);
+   the XML as a need of the same type, see ``Model._suite_why`` and ``Model._case_why``);
 3. runs ``sphinx-build -b html`` into OUT/html with SOURCE_DATE_EPOCH, PYTHONHASHSEED and the
    locale fixed, fails on any error, and writes OUT/manifest.json + OUT/manifest.sha256
    (SHA-256 of every input copy, generated source and rendered file) and OUT/evidence.json
@@ -78,7 +78,7 @@ def need_id(*parts: str, upper: bool = True) -> str:
     nid = _NEED_ID_BAD.sub("_", text.upper() if upper else text).strip("_")
     if not nid or not nid[0].isalpha():
         nid = "X_" + nid
-    return nid
+    return nid.ljust(3, "_")     # needs_id_regex: at least three characters
 
 
 def _no_dynamic(text: str) -> str:
@@ -246,6 +246,7 @@ class Inputs:
     analysis: list = field(default_factory=list)      # [(rel, data)]
     justifications: dict = field(default_factory=dict)  # UR id -> entry (spec/justifications)
     model_sources: dict = field(default_factory=dict)   # model path -> text (None: not found)
+    model_copies: dict = field(default_factory=dict)    # model path -> its copy under inputs/
     tool_versions: dict | None = None
     tool_versions_name: str | None = None
     files: list = field(default_factory=list)         # [InputFile]
@@ -361,7 +362,8 @@ def _load_model_source(inp: Inputs, model) -> None:
     except OSError:
         inp.model_sources[model] = None
         return
-    inp.files.append(InputFile(path, f"source/{path.relative_to(root).as_posix()}"))
+    inp.model_copies[model] = f"source/{path.relative_to(root).as_posix()}"
+    inp.files.append(InputFile(path, inp.model_copies[model]))
 
 
 def _load_vectors(inp: Inputs) -> None:
@@ -702,8 +704,11 @@ class Model:
                 src_check = "model file not in the source tree"
             props = []
             for p in d.get("properties", []):
+                # The same property checked in another configuration of the model (a
+                # variant) gets the configuration appended to its id.
+                config = str(p.get("configuration") or "")
                 nid = self._readable("PROP", p["name"]) if need_id("PROP", p["name"], upper=False) \
-                    not in self.need_ids else self._readable("PROP", stem, p["name"])
+                    not in self.need_ids else self._readable("PROP", p["name"], config or stem)
                 reqs = [r for r in p.get("requirements") or []]
                 links = [r for r in reqs if r in self.req_ids]
                 unknown = [r for r in reqs if r not in self.req_ids]
@@ -711,7 +716,8 @@ class Model:
                 for r in unknown:
                     self.problems.append(f"model property {p['name']} names unknown requirement {r}")
                 if verdict != "verified":
-                    self.problems.append(f"model property {p['name']} ({model}): {verdict}")
+                    where = f"{model}, configuration {config}" if config else model
+                    self.problems.append(f"model property {p['name']} ({where}): {verdict}")
                 incomplete = p.get("incomplete") or []
                 props.append({"id": nid, "name": p["name"], "kind": "ltl", "verdict": verdict,
                               "text": str(p.get("text") or ""),
@@ -753,9 +759,7 @@ class Model:
             other = [(str(k), fmt_value(v)) for k, v in d.items()
                      if k not in ("model", "model_sha256", "spin_version", "bounds", "properties",
                                   "mutants")]
-            source = None
-            if self.inp.model_sources.get(model) is not None:
-                source = f"source/{(self.inp.repo_root / model).resolve().relative_to(self.inp.repo_root.resolve()).as_posix()}"
+            source = self.inp.model_copies.get(model)
             commands = []
             for p in props:
                 if p["command"] and p["command"] not in commands:
@@ -1046,7 +1050,8 @@ class Model:
                             {"file": display_text(jf.rel), "suite": display_text(s.name),
                              "case": display_text(c.name),
                              "case_name": display_text(m.group("name") if m else c.name),
-                             "case_parameter": display_text(m.group("param") or "") if m else "",
+                             "case_parameter": display_text(m.group("param"))
+                             if m and m.group("param") else "",
                              "classname": display_text(c.classname), "result": c.result,
                              "time": _time_text(c.time)},
                             f"Rendered from the JUnit XML by the evidence build, not by "

@@ -20,6 +20,10 @@ FIX = Path(__file__).resolve().parent / "fixtures" / "evidence"
 SPEC = FIX / "spec"
 RESULTS = FIX / "results"
 TOOLS = FIX / "tool-versions.json"
+AWKWARD = FIX / "junit_names"          # JUnit files with names no directive option can carry
+# A trimmed pipeline run in the current formats (see its README.md).
+PIPE = Path(__file__).resolve().parent / "fixtures" / "evidence_pipeline"
+PIPE_SPEC, PIPE_RESULTS, PIPE_TOOLS = PIPE / "spec", PIPE / "results", PIPE / "tool-versions.json"
 
 
 def _snapshot(tree: Path) -> dict:
@@ -36,10 +40,44 @@ def _repo_copy(tmp: Path) -> Path:
     return root
 
 
-def _results_copy(tmp: Path, name: str = "results") -> Path:
+def _results_copy(tmp: Path, name: str = "results", src: Path = RESULTS) -> Path:
     dest = tmp / name
-    shutil.copytree(RESULTS, dest)
+    shutil.copytree(src, dest)
     return dest
+
+
+def _pipeline_repo(tmp: Path, with_model: bool = True) -> Path:
+    """A repository root with the evidence sources and the model the pipeline fixture's
+    results were computed from."""
+    root = _repo_copy(tmp)
+    if with_model:
+        shutil.copytree(PIPE / "models", root / "models")
+    return root
+
+
+def _pipeline_model(tmp: Path, results: Path | None = None, with_model: bool = True):
+    return evidence.Model(evidence.load_inputs(PIPE_SPEC, results or PIPE_RESULTS,
+                                               _pipeline_repo(tmp, with_model), PIPE_TOOLS), "cmd")
+
+
+def _table_rows(html: str, after: str = "") -> list:
+    """The rows of every need table in html (after the first occurrence of ``after``), each
+    a list of cell texts."""
+    import html as html_mod
+    if after:
+        html = html[html.index(after):]
+    rows = []
+    for tb in re.findall(r'<table class="NEEDS_(?:TABLE|DATATABLES)[^"]*".*?</table>', html, re.S):
+        for tr in re.findall(r"<tr[^>]*>(.*?)</tr>", tb, re.S):
+            cells = re.findall(r"<t[dh][^>]*>(.*?)</t[dh]>", tr, re.S)
+            rows.append([" ".join(html_mod.unescape(re.sub(r"<[^>]+>", " ", c)).split())
+                         for c in cells])
+    return rows
+
+
+def _needs(html_dir: Path) -> dict:
+    data = _read_json(html_dir / "needs.json")
+    return next(iter(data["versions"].values()))["needs"]
 
 
 def _read_json(p: Path):
@@ -93,6 +131,7 @@ def test_need_id_is_valid_for_sphinx_needs():
     assert evidence.need_id("TG-TRAP-017") == "TG-TRAP-017"
     assert evidence.need_id("tc", "Conformance/Vector Replay") == "TC_CONFORMANCE_VECTOR_REPLAY"
     assert evidence.need_id("1abc") == "X_1ABC"
+    assert evidence.need_id("TS", "") == "TS_"            # at least three characters
     assert evidence.need_id("TC", "Receiver", "Rejects.Repetition", upper=False) == \
         "TC_Receiver_Rejects_Repetition"
 
@@ -123,8 +162,92 @@ def test_junit_parser_counts_errors_and_skips(tmp_path):
                    '<testcase classname="S" name="later"><skipped/></testcase>'
                    '</testsuite></testsuites>', encoding="utf-8")
     jf = evidence._parse_junit(xml, "tests/r.xml")
-    assert [c.result for c in jf.suites[0][1]] == ["passed", "failure", "error", "skipped"]
+    assert [c.result for c in jf.suites[0].cases] == ["passed", "failure", "error", "skipped"]
     assert jf.error_elements == 1
+    assert jf.suites[0].cases[1].message == "x"
+    assert jf.reports_view is not None and jf.reports_view[0]["testcases"][2]["result"] == "passed"
+
+
+def test_display_text_and_plain_options():
+    assert evidence.display_text("a[[1]]\nb\tc") == "a[ [1] ]\\nb\\tc"
+    assert evidence.display_text(" x ") == "\\x20x\\x20"
+    assert evidence.display_text("a\u2028b") == "a\\u2028b"
+    assert evidence.display_text("") == "(empty)"
+    assert evidence.display_text("ümlaut [1, 2] 'q'") == "ümlaut [1, 2] 'q'"
+    for ok in ("TG_TRAP_G9_train", "test_x[a-b]", "- looks like a list", "a `b` \\ c"):
+        assert evidence.plain_option(ok), ok
+    for bad in ("", " x", "x ", "a  b", "a\nb", "a\tb", "x[[1]]", "x]]", "<<v>>", "ü"):
+        assert not evidence.plain_option(bad), bad
+    assert evidence.one_line("f([[1]])") == "f([ [1] ])"
+    assert evidence.rst_escape("[[copy('id')]]") == "[ [copy('id')] ]"
+
+
+def test_awkward_junit_names_are_rendered_from_the_parsed_xml(tmp_path):
+    """Every case sphinx-test-reports cannot address exactly gets an own-rendered need
+    with the reason; the others stay with sphinx-test-reports."""
+    results = _results_copy(tmp_path)
+    shutil.copytree(AWKWARD, results / "tests" / "awkward")
+    m = evidence.Model(evidence.load_inputs(SPEC, results, _repo_copy(tmp_path)), "cmd")
+    files = {f["rel"]: f for f in m.test_files}
+    awk = files["tests/awkward/awkward_names.xml"]
+    assert not awk["own"]                                    # the file itself is readable
+    why = {}
+    for s in awk["suites"]:
+        for c in s["cases"]:
+            why[(s["name"], c["name"])] = json.loads(c["own"])["note"] if c["own"] else ""
+    assert why[("pytest", "plain_name_is_rendered_by_sphinx_test_reports")] == ""
+    assert why[("pytest", "test_fails_plainly")] == ""
+    for name in ("test_requirement_rules[    sil: 2\n--requirements/telegram.yaml-REQ-TG-003-"
+                 "'sil' is a required property]", "  leading and trailing blanks  ",
+                 "test_nested[[[1, 2]], [[3]]]", "test_tab[a\tb]", "", "test_variant[<<a>>]"):
+        assert "one-line directive option" in why[("pytest", name)], name
+    assert "JUnit <error>" in why[("pytest", "test_raises_in_fixture")]
+    assert "empty literal block" in why[("pytest", "test_skipped_blank")]
+    same = [c for s in awk["suites"] for c in s["cases"] if c["name"] == "test_same_name"]
+    assert [c["result"] for c in same] == ["passed", "failure"]
+    assert not same[0]["own"] and "same class and name" in json.loads(same[1]["own"])["note"]
+    assert "nested suite" in why[("Outer/Inner", "NestedCase")]
+    assert "same name" in why[("pytest", "second_suite_of_the_same_name")]
+    assert "suite name" in why[("Suite\nwith newline", "InASuiteWithANewline")]
+    assert "suite name" in why[("", "")]
+    empty = [c for s in awk["suites"] if s["name"] == "" for c in s["cases"]]
+    assert [c["id"] for c in empty] == ["TC_"]               # ids keep sphinx-needs' minimum length
+    comma = files["tests/awkward/unparsable_time.xml"]
+    assert "sphinx-test-reports fails on this file (ValueError)" in json.loads(comma["own"])["note"]
+    assert all(c["own"] for s in comma["suites"] for c in s["cases"])
+    assert m.test_totals == {"passed": 94, "failure": 2, "error": 1, "skipped": 2}
+    assert m.verdict == "FAIL"
+
+
+def test_awkward_junit_names_render_without_a_warning(tmp_path):
+    results = _results_copy(tmp_path)
+    shutil.copytree(AWKWARD, results / "tests" / "awkward")
+    out = tmp_path / "out"
+    res = evidence.build(SPEC, results, _repo_copy(tmp_path), out, TOOLS)
+    assert res["warnings"] == 0 and (out / "sphinx-warnings.log").read_text() == ""
+    problems = res["summary"]["problems"]
+    assert sorted(p for p in problems if "awkward" in p) == [
+        "test testgen.tests.test_x.test_fails_plainly (tests/awkward/awkward_names.xml): failure",
+        "test testgen.tests.test_x.test_raises_in_fixture (tests/awkward/awkward_names.xml): error",
+        "test testgen.tests.test_x.test_same_name (tests/awkward/awkward_names.xml): failure"]
+    needs = _needs(out / "html")
+    cases = {nid: n for nid, n in needs.items() if n["type"] == "testcase"}
+    assert len(cases) == res["summary"]["counts"]["test_cases"] == 99
+    by_case = {}
+    for n in cases.values():
+        by_case.setdefault(n["case"], []).append(n["result"])
+    assert by_case["test_same_name"] == ["passed", "failure"]
+    assert by_case["test_raises_in_fixture"] == ["error"]
+    assert by_case["test_skipped_blank"] == ["skipped"]
+    assert by_case["test_nested[ [ [1, 2] ], [ [3] ] ]"] == ["passed"]
+    assert by_case["\\x20 leading and trailing blanks \\x20"] == ["passed"]
+    assert by_case["FirstCase"] == by_case["SecondCase"] == ["passed"]
+    tests = (out / "html" / "tests.html").read_text(encoding="utf-8")
+    # exact names in literal blocks; failure text shown, never executed or interpreted
+    assert '<pre><span></span>"test_nested[[[1, 2]], [[3]]]"' in tests
+    assert '<pre><span></span>"test_tab[a\\tb]"' in tests
+    assert '[[copy("id")]] is text here' in tests
+    assert "&lt;script&gt;alert(1)&lt;/script&gt;" in tests and "<script>alert" not in tests
 
 
 def test_unit_test_names_from_trace_match_gtest_and_pytest_cases():
@@ -235,15 +358,17 @@ def test_html_names_every_requirement_and_property_verdict(built):
     trace_page = (html / "traceability.html").read_text(encoding="utf-8")
     overview = (html / "overview.html").read_text(encoding="utf-8")
     for r in evidence.load_inputs(SPEC, RESULTS, REPO).requirements:
-        assert f'id="{r["id"]}"' in trace_page, r["id"]        # one need per requirement
+        page = (html / "requirements" / f"{r['id']}.html").read_text(encoding="utf-8")
+        assert f'id="{r["id"]}"' in page, r["id"]              # one need per requirement
+        assert f'href="requirements/{r["id"]}.html' in trace_page, r["id"]
         assert r["id"] in overview
     spin = _read_json(RESULTS / "spin" / "telegram.json")
     mc = (html / "model_checking.html").read_text(encoding="utf-8")
+    rows = {row[0]: row for row in _table_rows(mc)}
     for p in spin["properties"]:
         nid = evidence.need_id("PROP", p["name"], upper=False)
-        row = re.search(rf'<tr class="need[^"]*">\s*<td[^>]*><p><a [^>]*>{nid}</a></p></td>\s*'
-                        rf'<td[^>]*><p>([a-z]+)</p></td>', mc)
-        assert row and row.group(1) == p["verdict"], nid
+        assert rows[nid][2] == p["verdict"], nid               # id; configuration; verdict
+        assert rows[nid][3] == str(p["states_stored"]), nid
     for mu in spin["mutants"]:
         assert evidence.need_id("MUT", mu["name"], upper=False) in mc
     assert "Result: PASS" in overview
@@ -367,3 +492,174 @@ def test_a_sphinx_error_fails_the_build(tmp_path):
                                             r'Unknown directive type "no-such-directive"'):
         evidence.build(SPEC, RESULTS, repo, tmp_path / "out")
     assert not (tmp_path / "out" / "manifest.json").exists()
+
+
+# ------------------------------------------------------------------------------------------
+# the pipeline's current formats (fixtures/evidence_pipeline)
+
+
+def test_pipeline_formats_are_read(tmp_path):
+    m = _pipeline_model(tmp_path)
+    assert m.verdict == "PASS", m.problems
+    # coverage lists several vectors per goal
+    goals = {g["id"]: g for g in m.coverage[0]["goals"]}
+    assert goals["G9"]["vector_needs"] == ["TG-TRAP-G9-ground", "TG-TRAP-G9-train"]
+    assert goals["G12"]["status"] == "unreachable"
+    assert "window edge" in goals["G12"]["justification_text"]
+    # conformance cases link to the vector needs through their vector_id property
+    cases = {c["id"]: c for f in m.test_files for s in f["suites"] for c in s["cases"]}
+    assert cases["TC_TelegramConformance_TG_TRAP_G9_train"]["vectors"] == ["TG-TRAP-G9-train"]
+    assert cases["TC_TelegramConformance_TG_RANDOM_HEALTHYS1_ground"]["vectors"] == \
+        ["TG-RANDOM-HEALTHYS1-ground"]
+    assert cases["TC_TelegramConformance_VectorSet"]["vectors"] == []
+    assert {it["conformance"] for it in m.vector_items.values()} == {"passed"}
+    assert m.vector_items["TG-BOUNDARY-G14-ground"]["cases"] == \
+        ["TC_TelegramConformance_TG_BOUNDARY_G14_ground"]
+    # properties keep their extra fields; the named assertion is a need of its own
+    mo = m.models[0]
+    props = {p["name"]: p for p in mo["properties"]}
+    assert props["REQ_TG_016_availability"]["configuration"] == "HEALTHY"
+    assert props["REQ_TG_001_repetition"]["transitions"] == "4676998"
+    assert props["REQ_TG_001_repetition"]["command"].endswith("./pan -N REQ_TG_001_repetition")
+    assertions = {a["name"]: a for a in mo["assertions"]}
+    echo = assertions["assert:R_GUARANTEE_ECHO_AGE"]
+    assert echo["verdict"] == "verified" and echo["links"] == ["REQ-TG-012"]
+    assert "MUTANT_ECHO_NEVER_EXPIRES" in echo["basis"] and "all 11 verification runs" in echo["basis"]
+    assert assertions["assert:LIVE_PEER_WHEN_UP"]["links"] == ["REQ-TG-004"]
+    mutants = {mu["name"]: mu for mu in mo["mutants"]}
+    assert mutants["MUTANT_ECHO_NEVER_EXPIRES"]["target"] == echo["id"] == "ASSERT_R_GUARANTEE_ECHO_AGE"
+    assert "@OUT tx" in mutants["MUTANT_ECHO_NEVER_EXPIRES"]["counterexample"]
+    # the requirement pages resolve trace.json's assertion links to the assertion needs
+    req = {r["id"]: r for r in m.requirements}
+    assert {p["id"] for p in req["REQ-TG-012"]["props"]} == \
+        {"PROP_REQ_TG_009_turnaround", "ASSERT_R_GUARANTEE_ECHO_AGE"}
+    assert req["REQ-TG-012"]["model_unresolved"] == []
+    assert req["REQ-TG-012"]["vector_stats"] == {"total": 12, "passed": 12, "failed": 0,
+                                                  "skipped": 0, "not_replayed": 0}
+    assert len(req["REQ-TG-012"]["vectors"]) == 12 and req["REQ-TG-012"]["vectors_unresolved"] == []
+    assert [u["test"] for u in req["REQ-TG-012"]["unit_missing"]] == ["LLVMFuzzerTestOneInput"]
+    # the two parametrised pytest names with blanks and \n are rendered from the XML
+    assert m.own_rendered == 2
+
+
+def test_assertion_verdict_follows_the_runs_of_its_model(tmp_path):
+    results = _results_copy(tmp_path, src=PIPE_RESULTS)
+    spin = _read_json(results / "spin" / "telegram.json")
+    spin["properties"][3]["errors"] = 1
+    spin["properties"][3]["verdict"] = "violated"
+    _write_json(results / "spin" / "telegram.json", spin)
+    m = _pipeline_model(tmp_path / "a", results)
+    echo = next(a for a in m.models[0]["assertions"] if a["label"] == "R_GUARANTEE_ECHO_AGE")
+    assert echo["verdict"] == "not established"
+    assert any("model assertion R_GUARANTEE_ECHO_AGE" in p and "not established" in p
+               for p in m.problems)
+
+    for p in spin["properties"]:
+        p["errors"], p["verdict"] = 0, "verified"
+        p["command"] = p["command"].replace("./pan -N", "./pan -A -N")
+    _write_json(results / "spin" / "telegram.json", spin)
+    m = _pipeline_model(tmp_path / "b", results)
+    echo = next(a for a in m.models[0]["assertions"] if a["label"] == "R_GUARANTEE_ECHO_AGE")
+    assert echo["verdict"] == "not checked" and m.verdict == "FAIL"
+
+
+def test_a_property_checked_in_a_variant_gets_its_own_need(tmp_path):
+    results = _results_copy(tmp_path, src=PIPE_RESULTS)
+    spin = _read_json(results / "spin" / "telegram.json")
+    variant = copy.deepcopy(spin["properties"][0])
+    variant["configuration"] = "VARIANT_NARROW_WINDOW"
+    spin["properties"].append(variant)
+    _write_json(results / "spin" / "telegram.json", spin)
+    m = _pipeline_model(tmp_path, results)
+    ids = [p["id"] for p in m.models[0]["properties"] if p["name"] == "REQ_TG_001_repetition"]
+    assert ids == ["PROP_REQ_TG_001_repetition",
+                   "PROP_REQ_TG_001_repetition_VARIANT_NARROW_WINDOW"]
+    req = {r["id"]: r for r in m.requirements}
+    assert set(ids) <= {p["id"] for p in req["REQ-TG-001"]["props"]}
+    assert m.verdict == "PASS", m.problems
+
+
+def test_assertions_without_the_model_source_come_from_mutants_and_trace(tmp_path):
+    m = _pipeline_model(tmp_path, with_model=False)
+    names = {a["name"]: a for a in m.models[0]["assertions"]}
+    assert set(names) == {"assert:R_GUARANTEE_ECHO_AGE", "assert:LIVE_PEER_WHEN_UP"}
+    assert names["assert:R_GUARANTEE_ECHO_AGE"]["links"] == ["REQ-TG-012"]   # from trace.json
+    assert "model source is not in this package" in names["assert:R_GUARANTEE_ECHO_AGE"]["origin"]
+    assert m.models[0]["src_check"] == "model file not in the source tree"
+    assert m.verdict == "PASS", m.problems
+
+
+def test_conformance_gaps_fail_the_verdict(tmp_path):
+    results = _results_copy(tmp_path, src=PIPE_RESULTS)
+    conf = results / "tests" / "conformance.xml"
+    text = conf.read_text(encoding="utf-8")
+    # one vector loses its conformance case, another case names a vector that does not exist
+    text = re.sub(r'    <testcase name="TG_TRAP_G9_train".*?</testcase>\n', "", text, flags=re.S)
+    text = text.replace('value="TG-TRAP-G1-ground"', 'value="TG-TRAP-G99-ground"')
+    conf.write_text(text, encoding="utf-8")
+    m = _pipeline_model(tmp_path, results)
+    assert m.vector_items["TG-TRAP-G9-train"]["conformance"] == "not replayed"
+    assert "2 vector(s) not replayed by any conformance test case (first: TG-TRAP-G1-ground)" \
+        in m.problems
+    assert any("replays vector TG-TRAP-G99-ground, which is not in the vector files" in p
+               for p in m.problems)
+    assert m.verdict == "FAIL"
+
+    cov = _read_json(results / "vectors" / "telegram.coverage.json")
+    cov["goals"][0]["vectors"] = []
+    _write_json(results / "vectors" / "telegram.coverage.json", cov)
+    m = _pipeline_model(tmp_path / "b", results)
+    assert any(p.startswith("goal G0 (vectors/telegram.coverage.json): reached without vector")
+               for p in m.problems)
+
+
+@pytest.fixture(scope="module")
+def pipeline_built(tmp_path_factory):
+    """The pipeline fixture rendered twice, into two directories."""
+    tmp = tmp_path_factory.mktemp("pipeline")
+    repo = _pipeline_repo(tmp)
+    return [(tmp / name, evidence.build(PIPE_SPEC, PIPE_RESULTS, repo, tmp / name, PIPE_TOOLS))
+            for name in ("out1", "out2")]
+
+
+def test_pipeline_package_passes_without_warnings(pipeline_built):
+    (out1, res1), (out2, _) = pipeline_built
+    assert res1["summary"]["verdict"] == "PASS", res1["summary"]["problems"]
+    assert res1["warnings"] == 0 and (out1 / "sphinx-warnings.log").read_text() == ""
+    assert (out1 / "manifest.json").read_bytes() == (out2 / "manifest.json").read_bytes()
+    c = res1["summary"]["counts"]
+    assert (c["vectors"], c["vectors_replayed_passed"], c["vectors_not_replayed"]) == (42, 42, 0)
+    assert (c["assertions"], c["assertions_verified"]) == (2, 2)
+    assert c["test_cases"] == c["tests_passed"] == 253
+    assert "inputs/source/models/telegram.pml" in {a["path"] for a in _read_json(
+        out1 / "manifest.json")["artifacts"]}
+
+
+def test_requirement_page_shows_properties_vectors_and_conformance(pipeline_built):
+    html = pipeline_built[0][0] / "html"
+    page = (html / "requirements" / "REQ-TG-012.html").read_text(encoding="utf-8")
+    rows = {r[0]: r for r in _table_rows(page)}
+    # id; property; model; configuration; verdict; states; transitions; depth; time; memory
+    assert rows["PROP_REQ_TG_009_turnaround"][3:9] == \
+        ["default", "verified", "2468011", "4676998", "44", "2.28"]
+    assert rows["ASSERT_R_GUARANTEE_ECHO_AGE"][1] == "assert:R_GUARANTEE_ECHO_AGE"
+    assert rows["ASSERT_R_GUARANTEE_ECHO_AGE"][4] == "verified"
+    assert rows["MUT_MUTANT_ECHO_NEVER_EXPIRES"][1:] == \
+        ["rejected", "rejected", "ASSERT_R_GUARANTEE_ECHO_AGE"]
+    # id; kind; role; goal; steps; conformance; replayed by
+    assert rows["TG-TRAP-G9-train"][1:] == ["trap", "train", "G9: REJ_NO_ECHO", "2", "passed",
+                                            "TC_TelegramConformance_TG_TRAP_G9_train"]
+    assert rows["TG-RANDOM-S7-ground"][3] == "random walk, seed 7"
+    assert "12 passed, 0 failed, 0 skipped, 0 not" in page
+    # unit tests with their result; the fuzz target without one is listed
+    unit = sorted(k for k in rows if k.startswith("TC_"))
+    assert unit == ["TC_EndpointEcho_EchoValidityBoundaryAtMillisecondResolution",
+                    "TC_EndpointEcho_OnlyTelegramsPassingChecksOneToSixUpdateTheEchoedNumber",
+                    "TC_EndpointHandshake_GroundAndTrainBootstrapOverRealFrames",
+                    "TC_EndpointSequence_GapIsReportedByTheInSequenceTelegramEvenIfI_1C00B16A"]
+    assert {rows[k][1] for k in unit} == {"passed"}
+    assert "LLVMFuzzerTestOneInput" in page
+    tests = (html / "tests.html").read_text(encoding="utf-8")
+    assert "replays vector" in tests and 'href="vectors_telegram.html#TG-TRAP-G9-train"' in tests
+    mc = (html / "model_checking.html").read_text(encoding="utf-8")
+    assert "MUTANT_ECHO_NEVER_EXPIRES, which breaks this assertion" in mc
