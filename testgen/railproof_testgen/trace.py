@@ -305,6 +305,9 @@ class Tracer:
                 self._check_hash(f, data.get("model_sha256"), model_path)
             for i, p in enumerate(data["properties"]):
                 self._spin_property(f, i, p, model_path)
+            # named model assertions (// @assert): checked in every verification run
+            for i, a in enumerate(data.get("assertions") or []):
+                self._spin_property(f, i, a, model_path)
             mutants = data.get("mutants", [])
             if not isinstance(mutants, list):
                 self.error(f, "mutants", "must be a list")
