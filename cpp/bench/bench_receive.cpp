@@ -11,6 +11,7 @@
 #include <cstdlib>
 #include <span>
 
+#include "railproof/generated/telegram_params.hpp"
 #include "railproof/radio/endpoint.hpp"
 #include "railproof/radio/frame.hpp"
 
@@ -71,7 +72,7 @@ struct Link {
   // One cycle of both endpoints; the train's report reaches the ground at once, so the
   // ground's next control telegram echoes a fresh position sequence number.
   void Step() {
-    now += 500;
+    now += static_cast<std::uint32_t>(railproof::params::telegram::ground_cycle_ms);
     train.Cycle(now, {}, t_frame);
     ground.Receive(now, t_frame.View(), out);
     ground.Cycle(now, {}, g_frame);
