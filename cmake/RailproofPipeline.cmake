@@ -69,7 +69,7 @@ set(_residual ${RAILPROOF_RESULTS_DIR}/analysis/residual_error.json)
 add_custom_command(
   OUTPUT ${_residual}
   COMMAND ${CMAKE_COMMAND} -E make_directory ${RAILPROOF_RESULTS_DIR}/analysis
-  COMMAND residual_error --ber 1e-3 --ber 1e-4 --json ${_residual}
+  COMMAND residual_error --json ${_residual}  # bit error rates from spec/parameters
   DEPENDS residual_error
   COMMENT "analysis: residual error rate of RS(66,50)+CRC-16+MAC" VERBATIM)
 

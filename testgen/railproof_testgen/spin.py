@@ -74,10 +74,10 @@ class Annotations:
     goals: list = field(default_factory=list)
     mutants: list = field(default_factory=list)
     asserts: dict = field(default_factory=dict)
-    variants: list = field(default_factory=list)  # label -> (expression without spaces, requirements, text)
+    variants: list = field(default_factory=list)  # label -> (variables of the expression, requirements, text)
 
 
-def _squash(expr: str) -> frozenset:
+def _assert_signature(expr: str) -> frozenset:
     """Identify an assertion by its variables (pan prints it with macros expanded)."""
     return frozenset(re.findall(r"\b[a-z_][a-z0-9_]*\b", expr))
 
@@ -98,7 +98,7 @@ def parse_annotations(model: Path) -> Annotations:
             am = re.match(r"^\s*assert\((.*)\);?\s*$", nxt)
             if not am:
                 raise SpecError(model, f"line {lineno}", "@assert must be followed by an assert(...) line")
-            ann.asserts[m.group(1)] = (_squash(am.group(1)), _REQ.findall(m.group(2)), m.group(3).strip())
+            ann.asserts[m.group(1)] = (_assert_signature(am.group(1)), _REQ.findall(m.group(2)), m.group(3).strip())
             continue
         for rx, kind in ((_PROP, "property"), (_GOAL, "goal"), (_MUT, "mutant")):
             m = rx.match(line)
@@ -201,7 +201,7 @@ def parse_pan(out: str) -> dict:
         incomplete.append("no full state-space search reported")
     res["incomplete"] = incomplete
     m = re.search(r"assertion violated (.*?) \(at depth", out)
-    res["violated_expression"] = _squash(m.group(1)) if m else None
+    res["violated_expression"] = _assert_signature(m.group(1)) if m else None
     return res
 
 
