@@ -11,7 +11,8 @@ import sys
 
 from .errors import PipelineError, SpecError
 
-COMMAND_MODULES = ["params", "validate", "trace", "spin", "vectors", "evidence", "toolversions"]
+COMMAND_MODULES = ["params", "validate", "lines", "trace", "spin", "vectors", "evidence",
+                   "toolversions"]
 
 
 def build_parser():

@@ -3,8 +3,10 @@
 Command ``validate --spec DIR`` checks every YAML file of
 ``spec/{requirements,hazards,assumptions,parameters,justifications}`` against the
 Draft 2020-12 schemas in ``spec/schemas/``, then the cross-references the schemas cannot
-express. It collects every finding, prints each as one line ``file: entry: reason`` and
-exits 1 if there is any error (warnings alone do not fail).
+express. It also checks the line data ``spec/lines/*.yaml`` (if that directory exists)
+with the schema and topology rules of ``lines.py``; a line's assumption must exist. It
+collects every finding, prints each as one line ``file: entry: reason`` and exits 1 if
+there is any error (warnings alone do not fail).
 
 Rules checked after the schema:
 - IDs are unique within and across files (requirements, hazards, assumptions,
@@ -236,6 +238,13 @@ def check_spec(spec_dir):
                 for where, s in _strings({k: v for k, v in e.items() if k != "id"}):
                     refs.append((f, eid, where, s))
 
+    # Line data (spec/lines, REQ-MB-020): schema and topology rules; the lines' assumption
+    # and source strings join the cross-reference check below.
+    from . import lines as lines_mod  # imported here: lines builds on this module
+    line_outputs, line_refs = lines_mod.check_lines(spec_dir, report)
+    model["lines"] = line_outputs
+    refs.extend(line_refs)
+
     _check_references(model, refs, report)
     _check_requirements(model, report)
     _check_hazards_addressed(model, report)
@@ -245,7 +254,7 @@ def check_spec(spec_dir):
 
 def _empty_model():
     return {"requirements": {}, "hazards": {}, "assumptions": {}, "justifications": {},
-            "parameters": {}}
+            "parameters": {}, "lines": {}}
 
 
 def _collect_parameters(f, data, model, param_areas, refs, report):
@@ -364,7 +373,8 @@ def run(args):
         return 1
     print(f"validate: {args.spec} ok: {n['requirements']} requirements, {n['hazards']} hazards, "
           f"{n['assumptions']} assumptions, {n['parameters']} parameter file(s), "
-          f"{n['justifications']} justifications; {len(report.warnings)} warning(s)")
+          f"{n['justifications']} justifications, {n['lines']} line(s); "
+          f"{len(report.warnings)} warning(s)")
     return 0
 
 
@@ -372,8 +382,8 @@ def register(sub):
     p = sub.add_parser(
         "validate", help="check spec/ against its JSON schemas and cross-references",
         description="Validate every YAML file of spec/{requirements,hazards,assumptions,"
-                    "parameters,justifications} against spec/schemas and check IDs and "
-                    "references. Prints every finding as 'file: entry: reason'; exit 1 on "
-                    "any error.")
+                    "parameters,justifications,lines} against spec/schemas and check IDs, "
+                    "references and the line topology rules. Prints every finding as "
+                    "'file: entry: reason'; exit 1 on any error.")
     p.add_argument("--spec", required=True, help="spec/ directory")
     p.set_defaults(func=run)
