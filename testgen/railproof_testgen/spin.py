@@ -28,7 +28,8 @@ _GOAL = re.compile(r"^\s*//\s*@goal\s+(\d+)\s+((?:REQ-[A-Z]{2}-\d{3}\s*)+):\s*(.
 _MUT = re.compile(r"^\s*//\s*@mutant\s+(\w+)\s+violates\s+(\S+)\s*:\s*(.*)$")
 _ASSERT = re.compile(r"^\s*//\s*@assert\s+(\w+)\s+((?:REQ-[A-Z]{2}-\d{3}\s*)+):\s*(.*)$")
 _VARIANT = re.compile(r"^\s*//\s*@variant\s+(\w+)\s+(\w+)=(\w+)\s*:\s*(.*)$")
-_CONFIG = re.compile(r"\[config\s+(\w+)\]")
+_CONFIG = re.compile(r"\[config\s+(\w+(?:\s+\w+)*)\]")
+_PAN_FLAGS = re.compile(r"^\s*//\s*@pan_flags\s+((?:-D\w+(?:=\w+)?\s*)+)$")
 
 PAN_FLAGS = ["-O2", "-DSAFETY", "-DBFS", "-DMEMLIM=8000"]
 
@@ -38,7 +39,8 @@ class Property:
     name: str
     requirements: list
     text: str
-    config: str | None  # -D symbol of the configuration, None = default
+    config: str | None  # -D symbol of the (first) configuration, None = default
+    configs: list = field(default_factory=list)  # every configuration it is verified in
 
 
 @dataclass
@@ -46,6 +48,7 @@ class Goal:
     number: int
     requirements: list
     label: str
+    config: str | None = None  # configuration the trap property is searched in (None = default)
 
     @property
     def gid(self):
@@ -57,6 +60,7 @@ class Mutant:
     name: str
     violates: str  # property name or "assert:<label>"
     text: str
+    config: str | None = None  # configuration the mutant is checked in (None = default)
 
 
 @dataclass
@@ -75,6 +79,7 @@ class Annotations:
     mutants: list = field(default_factory=list)
     asserts: dict = field(default_factory=dict)
     variants: list = field(default_factory=list)  # label -> (variables of the expression, requirements, text)
+    pan_flags: list = field(default_factory=list)  # extra -D flags for compiling pan (// @pan_flags)
 
 
 def _assert_signature(expr: str) -> frozenset:
@@ -88,6 +93,10 @@ def parse_annotations(model: Path) -> Annotations:
     seen = set()
     lines = model.read_text(encoding="utf-8").splitlines()
     for lineno, line in enumerate(lines, 1):
+        m = _PAN_FLAGS.match(line)
+        if m:
+            ann.pan_flags.extend(m.group(1).split())
+            continue
         m = _VARIANT.match(line)
         if m:
             ann.variants.append(Variant(m.group(1), m.group(2), m.group(3), m.group(4).strip()))
@@ -110,12 +119,22 @@ def parse_annotations(model: Path) -> Annotations:
             seen.add(key)
             if kind == "property":
                 cfg = _CONFIG.search(m.group(3))
+                cfgs = cfg.group(1).split() if cfg else [None]
                 ann.properties.append(Property(m.group(1), _REQ.findall(m.group(2)), m.group(3).strip(),
-                                               cfg.group(1) if cfg else None))
+                                               cfgs[0], cfgs))
             elif kind == "goal":
-                ann.goals.append(Goal(int(m.group(1)), _REQ.findall(m.group(2)), m.group(3).strip()))
+                label = m.group(3).strip()
+                cfg = _CONFIG.search(label)
+                if cfg:
+                    label = _CONFIG.sub("", label).strip()
+                ann.goals.append(Goal(int(m.group(1)), _REQ.findall(m.group(2)), label,
+                                      cfg.group(1) if cfg else None))
             else:
-                ann.mutants.append(Mutant(m.group(1), m.group(2), m.group(3).strip()))
+                cfg = _CONFIG.search(m.group(3))
+                if cfg and len(cfg.group(1).split()) != 1:
+                    raise SpecError(model, m.group(1), "a mutant is checked in exactly one configuration")
+                ann.mutants.append(Mutant(m.group(1), m.group(2), m.group(3).strip(),
+                                          cfg.group(1) if cfg else None))
     if not ann.properties:
         raise SpecError(model, "-", "no // @property annotations")
     names = {p.name for p in ann.properties}
@@ -153,7 +172,7 @@ def _run(cmd, cwd, timeout=None):
     return subprocess.run(cmd, cwd=cwd, capture_output=True, text=True, timeout=timeout, check=False)
 
 
-def prepare(model: Path, params_dir: Path, workdir: Path, defines=(), extra_files=()):
+def prepare(model: Path, params_dir: Path, workdir: Path, defines=(), extra_files=(), cflags=None):
     """Copy the model and its generated includes into workdir, run spin -a, compile pan."""
     workdir = Path(workdir)
     if workdir.exists():
@@ -168,7 +187,9 @@ def prepare(model: Path, params_dir: Path, workdir: Path, defines=(), extra_file
     r = _run(["spin", *dflags, "-a", Path(model).name], workdir)
     if r.returncode != 0 or not (workdir / "pan.c").exists():
         raise PipelineError(f"spin -a {' '.join(dflags)} {model} failed:\n{r.stdout}{r.stderr}")
-    r = _run(["cc", *PAN_FLAGS, "-o", "pan", "pan.c"], workdir)
+    if cflags is None:
+        cflags = parse_annotations(model).pan_flags
+    r = _run(["cc", *PAN_FLAGS, *cflags, "-o", "pan", "pan.c"], workdir)
     if r.returncode != 0:
         raise PipelineError(f"compiling pan for {model} {' '.join(dflags)} failed:\n{r.stderr[-4000:]}")
     return workdir
@@ -224,7 +245,7 @@ def verify(model: Path, params_dir: Path, workdir: Path, out_json: Path, jobs: i
     version = spin_version()
     bounds = read_bounds(next(Path(params_dir).glob(f"{model.stem}_params.pml")))
     # every default-configuration property is also verified in every boundary variant
-    runs = [(p, p.config) for p in ann.properties]
+    runs = [(p, c) for p in ann.properties for c in p.configs]
     runs += [(p, v.define) for v in ann.variants for p in ann.properties if p.config is None]
     configs = sorted({c for _, c in runs}, key=lambda c: c or "")
     t0 = time.monotonic()
@@ -257,7 +278,7 @@ def verify(model: Path, params_dir: Path, workdir: Path, out_json: Path, jobs: i
         return {"name": p.name, "requirements": p.requirements, "text": p.text,
                 "configuration": config or "default", "verdict": verdict,
                 "command": f"spin {'-D' + config + ' ' if config else ''}-a {model.name} && "
-                           f"cc {' '.join(PAN_FLAGS)} -o pan pan.c && ./pan -N {p.name}",
+                           f"cc {' '.join(PAN_FLAGS + ann.pan_flags)} -o pan pan.c && ./pan -N {p.name}",
                 "counterexample": cex, **{k: v for k, v in res.items() if k != "violated_expression"}}
 
     _progress(f"verifying {len(ann.properties)} properties in {len(configs)} configuration(s): "
@@ -266,7 +287,8 @@ def verify(model: Path, params_dir: Path, workdir: Path, out_json: Path, jobs: i
         props = list(ex.map(run_prop, runs))
 
     def run_mutant(mu: Mutant):
-        wd = prepare(model, params_dir, Path(workdir) / f"mutant-{mu.name}", [mu.name])
+        mdefs = [mu.name] + ([mu.config] if mu.config else [])
+        wd = prepare(model, params_dir, Path(workdir) / f"mutant-{mu.name}", mdefs)
         claim = mu.violates if not mu.violates.startswith("assert:") else ann.properties[0].name
         r = _run(["./pan", "-N", claim], wd)
         res = parse_pan(r.stdout + r.stderr)
@@ -279,10 +301,11 @@ def verify(model: Path, params_dir: Path, workdir: Path, out_json: Path, jobs: i
             rejected = bool(res["errors"]) and violated not in model_asserts
         _progress(f"mutant {mu.name}: {'rejected' if rejected else 'SURVIVED'}")
         return {"name": mu.name, "property": mu.violates, "text": mu.text, "expect": "rejected",
+                "configuration": mu.config or "default",
                 "verdict": "rejected" if rejected else "survived",
                 "errors": res["errors"], "states_stored": res["states_stored"], "depth": res["depth"],
                 "time_s": res["time_s"],
-                "counterexample": counterexample(wd, model.name, [mu.name]) if rejected else None}
+                "counterexample": counterexample(wd, model.name, mdefs) if rejected else None}
 
     _progress(f"checking {len(ann.mutants)} mutant models")
     with ThreadPoolExecutor(max_workers=max(1, jobs)) as ex:
@@ -302,7 +325,7 @@ def verify(model: Path, params_dir: Path, workdir: Path, out_json: Path, jobs: i
         "model": f"models/{model.name}",
         "model_sha256": sha256_file(model),
         "spin_version": version,
-        "pan_flags": PAN_FLAGS,
+        "pan_flags": PAN_FLAGS + ann.pan_flags,
         "bounds": bounds,
         "properties": props,
         "assertions": assertions,

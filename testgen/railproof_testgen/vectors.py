@@ -132,7 +132,7 @@ def vectors_for_roles(stem, events, ids, requirements, goal, kind, seed):
              "kind": kind, "seed": seed, "steps": to_steps(events, role, ids)} for role in ROLES]
 
 
-def search_goal(model: Path, base: Path, workdir: Path, g, defines):
+def search_goal(model: Path, base: Path, workdir: Path, g, defines, parser=None):
     """Run the trap property of goal g on a copy of the compiled pan in `base`; return
     (status, events, pan results): reached with the replayed run, or unreachable."""
     tag = "".join(f"-{d}" for d in defines if d != "TRAPS")
@@ -144,7 +144,7 @@ def search_goal(model: Path, base: Path, workdir: Path, g, defines):
     res = spin_mod.parse_pan(r.stdout + r.stderr)
     if res["errors"]:
         rep = spin_mod._run(["spin", *[f"-D{d}" for d in defines], "-t", model.name], wd, timeout=300)
-        events = parse_events(rep.stdout)
+        events = (parser or parse_events)(rep.stdout)
         if not events:
             raise PipelineError(f"{model.name}: goal {g.gid}{tag} trail replay produced no events:\n"
                                 f"{rep.stdout[-2000:]}")
@@ -180,6 +180,9 @@ def _progress(msg):
 def generate(model: Path, params_dir: Path, spec_dir: Path, workdir: Path, out_dir: Path,
              walks: int = 50, walk_steps: int = 7000, jobs: int = 2):
     model = Path(model)
+    if model.stem == "moving_block":
+        from . import mb_vectors
+        return mb_vectors.generate(model, params_dir, spec_dir, workdir, out_dir, walks, jobs)
     model_rel = f"models/{model.name}"
     ann = spin_mod.parse_annotations(model)
     if not ann.goals:
@@ -277,8 +280,8 @@ def generate(model: Path, params_dir: Path, spec_dir: Path, workdir: Path, out_d
 
     # Walks in the other configurations of the model (e.g. HEALTHY: a perfect channel),
     # evidence for the properties verified in that configuration.
-    for config in sorted({p.config for p in ann.properties if p.config}):
-        creqs = sorted({r for p in ann.properties if p.config == config for r in p.requirements})
+    for config in sorted({c for p in ann.properties for c in p.configs if c}):
+        creqs = sorted({r for p in ann.properties if config in p.configs for r in p.requirements})
         n_cfg = max(1, walks // 10)
         _progress(f"{n_cfg} random walks in configuration {config}")
         for seed in range(1, n_cfg + 1):
