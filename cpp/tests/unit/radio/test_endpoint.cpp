@@ -19,65 +19,9 @@
 #include "railproof/radio/endpoint.hpp"
 #include "railproof/radio/frame.hpp"
 #include "railproof/radio/telegram.hpp"
+#include "../alloc_counter.hpp"
 
-// ---- allocation counter (REQ-TG-018: no heap per telegram) ------------------------------
-// Replaces the global allocation functions of the whole test binary; they count only while
-// g_count_allocations is set, so the rest of the binary is unaffected.
-namespace {
-std::atomic<bool> g_count_allocations{false};
-std::atomic<std::size_t> g_allocations{0};
-
-void* CountedAlloc(std::size_t size) {
-  if (g_count_allocations.load(std::memory_order_relaxed)) {
-    g_allocations.fetch_add(1, std::memory_order_relaxed);
-  }
-  void* p = std::malloc(size == 0 ? 1 : size);
-  if (p == nullptr) {
-    throw std::bad_alloc();
-  }
-  return p;
-}
-
-void* CountedAlignedAlloc(std::size_t size, std::align_val_t align) {
-  if (g_count_allocations.load(std::memory_order_relaxed)) {
-    g_allocations.fetch_add(1, std::memory_order_relaxed);
-  }
-  const auto a = static_cast<std::size_t>(align);
-  const std::size_t rounded = ((size == 0 ? 1 : size) + a - 1) / a * a;
-  void* p = std::aligned_alloc(a, rounded);
-  if (p == nullptr) {
-    throw std::bad_alloc();
-  }
-  return p;
-}
-}  // namespace
-
-void* operator new(std::size_t size) { return CountedAlloc(size); }
-void* operator new[](std::size_t size) { return CountedAlloc(size); }
-void* operator new(std::size_t size, const std::nothrow_t&) noexcept {
-  try {
-    return CountedAlloc(size);
-  } catch (...) {
-    return nullptr;
-  }
-}
-void* operator new[](std::size_t size, const std::nothrow_t&) noexcept {
-  try {
-    return CountedAlloc(size);
-  } catch (...) {
-    return nullptr;
-  }
-}
-void* operator new(std::size_t size, std::align_val_t align) { return CountedAlignedAlloc(size, align); }
-void* operator new[](std::size_t size, std::align_val_t align) { return CountedAlignedAlloc(size, align); }
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete[](void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
-void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
-void operator delete(void* p, std::align_val_t) noexcept { std::free(p); }
-void operator delete[](void* p, std::align_val_t) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t, std::align_val_t) noexcept { std::free(p); }
-void operator delete[](void* p, std::size_t, std::align_val_t) noexcept { std::free(p); }
+// Allocation counter (REQ-TG-018: no heap per telegram): cpp/tests/unit/alloc_counter.cpp.
 
 namespace railproof::radio {
 namespace {
@@ -860,8 +804,7 @@ TEST(EndpointRuntime, NoHeapAllocationInCycleOrReceiveAfterInit) {
   std::size_t accepted = 0;
   std::size_t rejected = 0;
 
-  g_allocations.store(0);
-  g_count_allocations.store(true);
+  railproof::testing::StartCountingAllocations();
   for (std::uint32_t i = 0; i < 50; ++i) {
     const std::uint32_t now = 500U * i;
     (void)ground.Cycle(now, kPayload, to_train);
@@ -873,17 +816,17 @@ TEST(EndpointRuntime, NoHeapAllocationInCycleOrReceiveAfterInit) {
     rejected += train.Receive(now + 40U, garbage, payload).reason != RejectReason::kNone ? 1U : 0U;
     rejected += train.Receive(now + 40U, to_train.View(), payload).reason != RejectReason::kNone ? 1U : 0U;
   }
-  g_count_allocations.store(false);
+  const std::size_t allocations = railproof::testing::StopCountingAllocations();
 
-  EXPECT_EQ(g_allocations.load(), 0U);
+  EXPECT_EQ(allocations, 0U);
   EXPECT_GE(accepted, 95U);  // all but the bootstrap telegram(s)
   EXPECT_EQ(rejected, 200U);
   // The counter itself works (otherwise the assertion above would be vacuous).
-  g_count_allocations.store(true);
+  railproof::testing::StartCountingAllocations();
   void* probe = ::operator new(sizeof(int));
-  g_count_allocations.store(false);
+  const std::size_t probe_allocations = railproof::testing::StopCountingAllocations();
   ::operator delete(probe);
-  EXPECT_EQ(g_allocations.load(), 1U);
+  EXPECT_EQ(probe_allocations, 1U);
 }
 
 }  // namespace
