@@ -7,7 +7,7 @@
 #   evidence  : test results as JUnit XML (unit, conformance, testgen), residual-error
 #               analysis, tool versions, trace.json, and the rendered evidence package
 #               in ${CMAKE_BINARY_DIR}/evidence (HTML + manifest.json with SHA-256).
-set(RAILPROOF_MODELS telegram)
+set(RAILPROOF_MODELS telegram moving_block)
 set(RAILPROOF_VECTOR_DIR ${RAILPROOF_RESULTS_DIR}/vectors)
 set(_spin_outputs)
 set(_vector_outputs)
@@ -56,6 +56,17 @@ if(TARGET railproof_conformance)
     USES_TERMINAL VERBATIM)
   list(APPEND _evidence_tests ${_tests_dir}/conformance.xml)
 endif()
+if(TARGET railproof_conformance_mb)
+  add_custom_command(
+    OUTPUT ${_tests_dir}/conformance_mb.xml
+    COMMAND ${CMAKE_COMMAND} -E make_directory ${_tests_dir}
+    COMMAND railproof_conformance_mb --vectors ${RAILPROOF_VECTOR_DIR}
+            --gtest_output=xml:${_tests_dir}/conformance_mb.xml
+    DEPENDS railproof_conformance_mb ${_vector_outputs}
+    COMMENT "tests: moving-block conformance replay -> results/tests/conformance_mb.xml"
+    USES_TERMINAL VERBATIM)
+  list(APPEND _evidence_tests ${_tests_dir}/conformance_mb.xml)
+endif()
 add_custom_command(
   OUTPUT ${_tests_dir}/testgen.xml
   COMMAND ${CMAKE_COMMAND} -E make_directory ${_tests_dir}
@@ -73,7 +84,37 @@ add_custom_command(
   DEPENDS residual_error
   COMMENT "analysis: residual error rate of RS(66,50)+CRC-16+MAC" VERBATIM)
 
-add_custom_target(railproof_analysis_results ALL DEPENDS ${_residual})
+# Line scenarios (spec/scenarios/*.json): the C++ ground and on-board units, train dynamics
+# and the telegram layer over a lossy channel, with faults; every safety invariant checked
+# at every step (line_sim exits non-zero on any violation). Summaries (with the
+# requirements they evidence) go to results/analysis, logs and diagrams to results/scenarios.
+set(_scenario_outputs)
+if(TARGET line_sim)
+  file(GLOB _scenarios CONFIGURE_DEPENDS ${RAILPROOF_SOURCE_DIR}/spec/scenarios/*.json)
+  foreach(sc ${_scenarios})
+    get_filename_component(n ${sc} NAME_WE)
+    set(_sum ${RAILPROOF_RESULTS_DIR}/analysis/scenario_${n}.json)
+    add_custom_command(
+      OUTPUT ${_sum} ${RAILPROOF_RESULTS_DIR}/scenarios/${n}.svg
+      COMMAND ${CMAKE_COMMAND} -E make_directory ${RAILPROOF_RESULTS_DIR}/scenarios ${RAILPROOF_RESULTS_DIR}/analysis
+      COMMAND line_sim --scenario ${sc} --lines-dir ${RAILPROOF_GEN_DIR}/lines --quiet
+              --log ${RAILPROOF_RESULTS_DIR}/scenarios/${n}.log.json
+              --svg ${RAILPROOF_RESULTS_DIR}/scenarios/${n}.svg --summary ${_sum}
+      DEPENDS line_sim ${sc} ${RAILPROOF_LINE_JSON}
+      COMMENT "sim: scenario ${n}" VERBATIM)
+    list(APPEND _scenario_outputs ${_sum})
+  endforeach()
+  set(_sweep ${RAILPROOF_RESULTS_DIR}/analysis/scenario_gap_sweep.json)
+  add_custom_command(
+    OUTPUT ${_sweep}
+    COMMAND line_sim --scenario ${RAILPROOF_SOURCE_DIR}/spec/scenarios/d5_follow_20kmh.json
+            --lines-dir ${RAILPROOF_GEN_DIR}/lines --quiet --sweep-leader-cap 20,40,60,80 --summary ${_sweep}
+    DEPENDS line_sim ${RAILPROOF_SOURCE_DIR}/spec/scenarios/d5_follow_20kmh.json ${RAILPROOF_LINE_JSON}
+    COMMENT "sim: follower gap against leader speed (D5 field test)" VERBATIM)
+  list(APPEND _scenario_outputs ${_sweep})
+endif()
+
+add_custom_target(railproof_analysis_results ALL DEPENDS ${_residual} ${_scenario_outputs})
 
 set(_tools ${RAILPROOF_RESULTS_DIR}/tool-versions.json)
 add_custom_command(
@@ -89,7 +130,7 @@ add_custom_command(
   OUTPUT ${_trace}
   COMMAND ${RAILPROOF_TESTGEN} trace --spec ${RAILPROOF_SOURCE_DIR}/spec --src ${RAILPROOF_SOURCE_DIR}
           --results ${RAILPROOF_RESULTS_DIR} --out ${_trace}
-  DEPENDS ${_spin_outputs} ${_vector_outputs} ${_residual} ${_traced_sources} ${RAILPROOF_SPEC_FILES}
+  DEPENDS ${_spin_outputs} ${_vector_outputs} ${_residual} ${_scenario_outputs} ${_traced_sources} ${RAILPROOF_SPEC_FILES}
   COMMENT "trace: requirement <-> property/vector/code/test links" VERBATIM)
 
 set(_manifest ${CMAKE_BINARY_DIR}/evidence/manifest.json)
@@ -98,7 +139,7 @@ add_custom_command(
   OUTPUT ${_manifest}
   COMMAND ${RAILPROOF_TESTGEN} evidence --spec ${RAILPROOF_SOURCE_DIR}/spec --results ${RAILPROOF_RESULTS_DIR}
           --src ${RAILPROOF_SOURCE_DIR} --out ${CMAKE_BINARY_DIR}/evidence --tool-versions ${_tools}
-  DEPENDS ${_trace} ${_evidence_tests} ${_residual} ${_tools} ${_evidence_sources}
+  DEPENDS ${_trace} ${_evidence_tests} ${_residual} ${_scenario_outputs} ${_tools} ${_evidence_sources}
   COMMENT "evidence: rendering the assessor's package (Sphinx + sphinx-needs)" USES_TERMINAL VERBATIM)
 add_custom_target(evidence DEPENDS ${_manifest})
 

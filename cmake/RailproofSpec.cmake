@@ -7,8 +7,10 @@ file(MAKE_DIRECTORY ${RAILPROOF_GEN_INCLUDE}/railproof/generated ${RAILPROOF_GEN
 file(GLOB RAILPROOF_SPEC_FILES CONFIGURE_DEPENDS
   ${RAILPROOF_SOURCE_DIR}/spec/*/*.yaml ${RAILPROOF_SOURCE_DIR}/spec/schemas/*.json)
 file(GLOB RAILPROOF_TESTGEN_FILES CONFIGURE_DEPENDS ${RAILPROOF_SOURCE_DIR}/testgen/railproof_testgen/*.py)
-set(RAILPROOF_PARAM_HEADER ${RAILPROOF_GEN_INCLUDE}/railproof/generated/telegram_params.hpp)
-set(RAILPROOF_PARAM_PML ${RAILPROOF_GEN_DIR}/models/telegram_params.pml)
+set(RAILPROOF_PARAM_HEADER ${RAILPROOF_GEN_INCLUDE}/railproof/generated/telegram_params.hpp
+    ${RAILPROOF_GEN_INCLUDE}/railproof/generated/moving_block_params.hpp)
+set(RAILPROOF_PARAM_PML ${RAILPROOF_GEN_DIR}/models/telegram_params.pml
+    ${RAILPROOF_GEN_DIR}/models/moving_block_params.pml)
 add_custom_command(
   OUTPUT ${RAILPROOF_PARAM_HEADER} ${RAILPROOF_PARAM_PML}
   COMMAND ${RAILPROOF_TESTGEN} gen-params --spec ${RAILPROOF_SOURCE_DIR}/spec --out ${RAILPROOF_GEN_DIR}
@@ -16,3 +18,19 @@ add_custom_command(
   COMMENT "spec: validating spec/ and generating parameter headers"
   VERBATIM)
 add_custom_target(railproof_gen_params DEPENDS ${RAILPROOF_PARAM_HEADER} ${RAILPROOF_PARAM_PML})
+
+# Line data (spec/lines/*.yaml): validated (schema + topology rules, errors name the file
+# and entry) and converted to the JSON the C++ line simulator reads (build/gen/lines).
+file(GLOB RAILPROOF_LINE_FILES CONFIGURE_DEPENDS ${RAILPROOF_SOURCE_DIR}/spec/lines/*.yaml)
+set(RAILPROOF_LINE_JSON)
+foreach(f ${RAILPROOF_LINE_FILES})
+  get_filename_component(n ${f} NAME_WE)
+  list(APPEND RAILPROOF_LINE_JSON ${RAILPROOF_GEN_DIR}/lines/${n}.json)
+endforeach()
+add_custom_command(
+  OUTPUT ${RAILPROOF_LINE_JSON}
+  COMMAND ${RAILPROOF_TESTGEN} lines --spec ${RAILPROOF_SOURCE_DIR}/spec --out ${RAILPROOF_GEN_DIR}/lines
+  DEPENDS ${RAILPROOF_LINE_FILES} ${RAILPROOF_SPEC_FILES} ${RAILPROOF_TESTGEN_FILES}
+  COMMENT "spec: validating spec/lines and writing the line JSON"
+  VERBATIM)
+add_custom_target(railproof_gen_lines ALL DEPENDS ${RAILPROOF_LINE_JSON})

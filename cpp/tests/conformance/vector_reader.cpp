@@ -344,7 +344,10 @@ LoadResult LoadVectorDirectory(const std::filesystem::path& dir) {
   }
   std::vector<std::filesystem::path> files;
   for (const auto& entry : std::filesystem::directory_iterator(dir, ec)) {
-    if (entry.is_regular_file() && entry.path().extension() == ".jsonl") {
+    // telegram*.jsonl: the telegram-layer vectors (other models' files are replayed by
+    // their own runners, e.g. railproof_conformance_mb for moving_block*.jsonl)
+    if (entry.is_regular_file() && entry.path().extension() == ".jsonl" &&
+        entry.path().filename().string().rfind("telegram", 0) == 0) {
       files.push_back(entry.path());
     }
   }
@@ -354,7 +357,7 @@ LoadResult LoadVectorDirectory(const std::filesystem::path& dir) {
   }
   std::sort(files.begin(), files.end());
   if (files.empty()) {
-    result.error = "no *.jsonl vector file in " + dir.string();
+    result.error = "no *.jsonl vector file (telegram*.jsonl) in " + dir.string();
     return result;
   }
   for (const auto& path : files) {

@@ -110,7 +110,7 @@ struct LoadResult {
 
 std::string SanitizeTestName(const std::string& id);
 
-// Reads every *.jsonl file of dir (sorted by name). Fails if dir is missing or not a
+// Reads every telegram*.jsonl file of dir (sorted by name). Fails if dir is missing or not a
 // directory, has no *.jsonl file, or holds no vector at all; fails on the first malformed
 // line (naming file and line) and on duplicate test names.
 LoadResult LoadVectorDirectory(const std::filesystem::path& dir);
