@@ -416,7 +416,7 @@ inline ground_cycle() {
        fi;
        grant[h_t] = h_best;
        HIST(h_t, 0) = h_best;
-       printf("@OUT train t=%d grant=%d why=%d abn=0\n", h_t, h_best, h_why);
+       printf("@OUT train t=%d grant=%d why=%d abn=0 usable=%d\n", h_t, h_best, h_why, USABLE(h_t));
        if
        :: h_why == W_TRAIN -> GOAL(4)
        :: h_why == W_FIXED -> GOAL(5)
@@ -428,7 +428,7 @@ inline ground_cycle() {
        :: h_why == W_EOT -> GOAL(11)
        fi
     :: else ->
-       printf("@OUT train t=%d grant=%d why=0 abn=1\n", h_t, grant[h_t])
+       printf("@OUT train t=%d grant=%d why=0 abn=1 usable=%d\n", h_t, grant[h_t], USABLE(h_t))
     fi
   }
   h_occ = 0;
@@ -730,7 +730,7 @@ ltl REQ_MB_008_separation { [] !v_sep }
 ltl REQ_MB_007_limits { [] !v_lim }
 // @property REQ_MB_009_stale REQ-MB-009 : a usable on-board stop limit never exceeds what the ground currently protects (the limits it issued within the validity window): a stale, delayed or re-ordered telegram never extends authority [config CORE TRIO FEATURE_POSS FEATURE_ROUTE FEATURE_RADIO]
 ltl REQ_MB_009_stale { [] !v_stale }
-// @property REQ_MB_011_points REQ-MB-011 REQ-MB-013 : the points never move while a train occupies their block or a route over them is set [config CORE TRIO FEATURE_ROUTE]
+// @property REQ_MB_011_points REQ-MB-011 REQ-MB-013 : the points never move while a train occupies their block or a route over them is set [config FEATURE_ROUTE]
 ltl REQ_MB_011_points { [] !v_points }
 // @property REQ_MB_012_routes REQ-MB-012 : the main route and the conflicting siding route are never set together [config FEATURE_ROUTE]
 ltl REQ_MB_012_routes { [] !v_routes }
@@ -741,7 +741,6 @@ ltl REQ_MB_018_progress { [] !v_behind }
 
 // @mutant MUTANT_NO_TRAIN_MARGIN violates REQ_MB_007_limits : the preceding-train margin is omitted [config CORE]
 // @mutant MUTANT_ABNORMAL_RELEASED violates REQ_MB_008_separation : a train with abnormal tracking no longer obstructs [config CORE]
-// @mutant MUTANT_SET_BACK_ANYWHERE violates REQ_MB_007_limits : trains may set back outside the set-back section, eating into the margin behind them [config TRIO]
 // @mutant MUTANT_NO_FIXED_BLOCK violates REQ_MB_007_limits : an occupied platform (fixed block) is not an obstruction [config TRIO]
 // @mutant MUTANT_VALIDITY_FROM_RECEPTION violates REQ_MB_009_stale : the on-board unit counts validity from reception instead of issue [config CORE]
 // @mutant MUTANT_LOCK_IGNORES_AUTHORITY violates REQ_MB_011_points : route release and point moves ignore authority still held by trains [config FEATURE_ROUTE]

@@ -58,6 +58,28 @@ EXCLUDED = {
     "**/__pycache__/": "Python byte code (not written: PYTHONDONTWRITEBYTECODE=1)",
 }
 
+# Verification configurations of models/moving_block.pml (its header comment and
+# spec/design/moving-block.md §5), in the order the chapter lists them.
+MB_CONFIGURATIONS = {
+    "default": "the full model: every train of the model bounds and every environment command "
+               "(possession, siding route, radio cells, boundary) with every fault",
+    "CORE": "2 trains over the whole line; every report, tracking, set-back and telegram fault "
+            "(loss, delay, re-ordering); no infrastructure commands",
+    "TRIO": "3 trains with every fault of CORE, confined to the first blocks: the next radio cell "
+            "is never secured, so the handover point ends their run (the platform, the only fixed "
+            "block and set-back section, lies before it)",
+    "FEATURE_POSS": "2 trains; possessions requested, confirmed and cancelled at any time "
+                    "(telegrams lost but not held back)",
+    "FEATURE_ROUTE": "2 trains; the siding route over the points requested and freed at any time "
+                     "(telegrams lost but not held back)",
+    "FEATURE_RADIO": "2 trains; radio cells secured and the boundary accepted at any time "
+                     "(telegrams lost but not held back)",
+    "FAIR": "a healthy system: every report and telegram arrives in its cycle, no possession or "
+            "siding request; for the progress property",
+    "TRAINS2": "the full model with 2 trains (cost table)",
+    "TRAINS4": "the full model with 4 trains (cost table)",
+}
+
 _NEED_ID_BAD = re.compile(r"[^A-Za-z0-9_-]+")
 _RST_SPECIAL = re.compile(r"([\\`*_|])")
 _RST_BLOCK_START = re.compile(r"^(?:[-+•]\s|\d+[.)]\s|[a-zA-Z#][.)]\s|\.\.(?:\s|$)|::|>>>)")
@@ -155,6 +177,25 @@ def fmt_value(v) -> str:
     return str(v)
 
 
+def _count(items) -> dict:
+    out: dict = {}
+    for x in items:
+        out[x] = out.get(x, 0) + 1
+    return out
+
+
+def _flatten(obj: dict, prefix: str = "") -> dict:
+    """{"a": {"b": 1}, "c": [1, 2]} -> {"a.b": 1, "c": [1, 2]} (lists kept as values)."""
+    out: dict = {}
+    for k, v in obj.items():
+        key = f"{prefix}.{k}" if prefix else str(k)
+        if isinstance(v, dict) and v:
+            out.update(_flatten(v, key))
+        else:
+            out[key] = v
+    return out
+
+
 def safe_json_line(obj) -> str:
     """One JSON line for display inside need content. sphinx-needs treats ``[[`` ... ``]]``
     in need content as a dynamic function, so adjacent brackets are spaced apart (the
@@ -244,6 +285,8 @@ class Inputs:
     coverage: list = field(default_factory=list)      # [(rel, data)]
     junit: list = field(default_factory=list)         # [JUnitFile]
     analysis: list = field(default_factory=list)      # [(rel, data)]
+    scenario_plots: list = field(default_factory=list)  # [(name, Path of scenarios/<name>.svg)]
+    scenario_logs: dict = field(default_factory=dict)   # name -> rel of scenarios/<name>.log.json
     justifications: dict = field(default_factory=dict)  # UR id -> entry (spec/justifications)
     model_sources: dict = field(default_factory=dict)   # model path -> text (None: not found)
     model_copies: dict = field(default_factory=dict)    # model path -> its copy under inputs/
@@ -495,6 +538,27 @@ def _load_analysis(inp: Inputs) -> None:
         inp.files.append(InputFile(f, f"results/{rel}"))
 
 
+def _load_scenarios(inp: Inputs) -> None:
+    """The line simulator's plots (scenarios/<name>.svg) and event logs (<name>.log.json):
+    copied verbatim like every input; the plots are also embedded in the moving-block
+    chapter (copied into the Sphinx sources, so they are hashed with the HTML)."""
+    sdir = inp.results_dir / "scenarios"
+    if not sdir.is_dir():
+        return
+    for f in sorted(p for p in sdir.iterdir() if p.is_file()):
+        rel = _rel(f, inp.results_dir)
+        if f.name.endswith(".svg"):
+            head = f.read_bytes()[:4096].lstrip()
+            _require(head.startswith(b"<?xml") or head.startswith(b"<svg"), f, "-",
+                     "not an SVG image")
+            inp.scenario_plots.append((f.name[:-len(".svg")], f))
+        elif f.name.endswith(".log.json"):
+            inp.scenario_logs[f.name[:-len(".log.json")]] = rel
+        else:
+            continue
+        inp.files.append(InputFile(f, f"results/{rel}"))
+
+
 def _load_tool_versions(inp: Inputs, path: Path | None) -> None:
     if path is None:
         inp.missing.append("tool versions (--tool-versions)")
@@ -517,6 +581,7 @@ def load_inputs(spec_dir: Path, results_dir: Path, repo_root: Path,
     _load_vectors(inp)
     _load_tests(inp)
     _load_analysis(inp)
+    _load_scenarios(inp)
     _load_tool_versions(inp, Path(tool_versions) if tool_versions else None)
     return inp
 
@@ -612,6 +677,7 @@ class Model:
         self._conformance()
         self._analysis()
         self._requirement_links()
+        self._moving_block()
         self._versions()
         self._verdict()
 
@@ -992,7 +1058,10 @@ class Model:
                 return []
             return [nid]
         toks = _tokens(f"{c.classname} {c.name}")
-        return sorted({nid for vt, nid in vec_tokens if _contains_seq(toks, vt)})
+        hits = [(vt, nid) for vt, nid in vec_tokens if _contains_seq(toks, vt)]
+        # MB-TRAP-G1 is spelled inside MB_TRAP_G1_2 too: keep only the most specific ids
+        return sorted({nid for vt, nid in hits
+                       if not any(len(o) > len(vt) and _contains_seq(o, vt) for o, _ in hits)})
 
     def _tests(self):
         unit_map = []   # (test string, requirement)
@@ -1129,6 +1198,11 @@ class Model:
 
     # -- analysis -------------------------------------------------------------------------
     def _analysis(self):
+        """One need per analysis result. Nested objects are flattened into dotted names
+        (``channel.loss_probability``); a list of records, or an object whose values are all
+        records (``checks``: one record per requirement), is a table with flattened columns.
+        A record with ``meets_target: false`` or ``result: FAIL`` (at the top level or in a
+        table) fails the package."""
         self.analyses = []
         for rel, d in self.inp.analysis:
             stem = Path(rel).stem
@@ -1138,20 +1212,30 @@ class Model:
             for k, v in d.items():
                 if k == "requirements":
                     continue
+                records = None
                 if isinstance(v, list) and v and all(isinstance(x, dict) for x in v):
-                    cols = []
-                    for row in v:
+                    records = [(None, x) for x in v]
+                elif isinstance(v, dict) and v and all(isinstance(x, dict) for x in v.values()):
+                    records = list(v.items())
+                if records is not None:
+                    flat = [_flatten(row) for _, row in records]
+                    cols = [] if records[0][0] is None else ["key"]
+                    for row in flat:
                         for c in row:
                             if c not in cols:
                                 cols.append(c)
-                    rows = [[fmt_value(row.get(c)) for c in cols] for row in v]
+                    rows = [[fmt_value(key if c == "key" and key is not None else row.get(c))
+                             for c in cols] for (key, _), row in zip(records, flat)]
                     tables.append({"name": k, "columns": cols, "rows": rows})
-                    for i, row in enumerate(v):
-                        if row.get("meets_target") is False:
-                            fails.append(f"{k}[{i}]")
+                    for i, ((key, _), row) in enumerate(zip(records, flat)):
+                        if row.get("meets_target") is False or str(row.get("result")) == "FAIL":
+                            fails.append(f"{k}[{i if key is None else key}]")
+                elif isinstance(v, dict):
+                    for fk, fv in _flatten(v, k).items():
+                        scalars.append((fk, fmt_value(fv)))
                 else:
-                    scalars.append((k, fmt_value(v)))
-                    if k == "meets_target" and v is False:
+                    scalars.append((k, fmt_value(v) if v != [] else "none"))
+                    if (k == "meets_target" and v is False) or (k == "result" and v == "FAIL"):
                         fails.append(k)
             for r in reqs:
                 if r not in self.req_ids:
@@ -1161,10 +1245,11 @@ class Model:
                 self.problems.append(f"analysis {rel}: target not met in {', '.join(fails)}")
             self.analyses.append({"id": nid, "rel": rel, "stem": stem,
                                   "title": stem.replace("_", " "),
+                                  "schema": str(d.get("schema") or ""),
                                   "links": [r for r in reqs if r in self.req_ids],
                                   "unknown": [r for r in reqs if r not in self.req_ids],
                                   "scalars": scalars, "tables": tables, "outcome": outcome,
-                                  "fails": fails})
+                                  "fails": fails, "data": d})
 
     # -- requirements with their trace ----------------------------------------------------
     def _requirement_links(self):
@@ -1242,6 +1327,135 @@ class Model:
         for (fname, area), items in by_file.items():
             self.areas.append({"file": fname, "area": area, "requirements": items})
         self.req_ok = sum(r["status"] == "ok" for r in self.requirements)
+
+    # -- moving-block chapter -------------------------------------------------------------
+    def _moving_block(self):
+        """The data of the moving-block chapter, gathered from the generic results: the
+        REQ-MB requirements, the moving_block model's runs per configuration, its goal
+        coverage, vector files and conformance test file, and the line simulator's
+        scenario summaries, gap sweep and plots."""
+        cfg_rank = {c: i for i, c in enumerate(MB_CONFIGURATIONS)}
+        mb = {"requirements": [r for r in self.requirements if r["id"].startswith("REQ-MB-")]}
+        model = next((mo for mo in self.models if mo["stem"] == "moving_block"
+                      or mo["model"].endswith("moving_block.pml")), None)
+        mb["model"] = model
+        runs, configs, names = [], [], []
+        if model:
+            for p in model["properties"]:
+                cfg = p["configuration"] or "default"
+                if cfg not in configs:
+                    configs.append(cfg)
+                if p["name"] not in names:
+                    names.append(p["name"])
+            order = {n: i for i, n in enumerate(names)}
+            runs = sorted(model["properties"], key=lambda p: (
+                order[p["name"]], cfg_rank.get(p["configuration"] or "default", len(cfg_rank)),
+                p["configuration"]))
+            for mu in model["mutants"]:
+                cfg = dict(mu["extra"]).get("configuration", "default")
+                mu["configuration"] = cfg
+                if cfg not in configs:
+                    configs.append(cfg)
+        configs.sort(key=lambda c: (cfg_rank.get(c, len(cfg_rank)), c))
+        mb["runs"] = runs
+        mb["properties"] = names
+        mb["configurations"] = [(c, MB_CONFIGURATIONS.get(c, "(not described in this package)"),
+                                 sum((p["configuration"] or "default") == c for p in runs))
+                                for c in configs]
+        mb["mutants"] = model["mutants"] if model else []
+        # goal coverage
+        cov = next((c for c in self.coverage if Path(c["rel"]).name.startswith("moving_block")), None)
+        mb["coverage"] = cov
+        raw = next((d for rel, d in self.inp.coverage if cov and rel == cov["rel"]), {})
+        per_cfg: dict = {}
+        for g, rg in zip(cov["goals"] if cov else [], raw.get("goals", [])):
+            g["configuration"] = str(rg.get("configuration") or "default")
+            st = per_cfg.setdefault(g["configuration"], {"labelled": 0, "reached": 0, "unreachable": 0})
+            st["labelled"] += 1
+            if g["status"] in ("reached", "unreachable"):
+                st[g["status"]] += 1
+        mb["goal_configs"] = [(c, v["labelled"], v["reached"], v["unreachable"])
+                              for c, v in sorted(per_cfg.items(),
+                                                 key=lambda kv: (cfg_rank.get(kv[0], 99), kv[0]))]
+        files_map = raw.get("files") if isinstance(raw.get("files"), dict) else {}
+        # vector files
+        vfs = []
+        for vf in self.vector_files:
+            if not Path(vf["rel"]).name.startswith("moving_block"):
+                continue
+            header = dict(vf["header"])
+            items = vf["items"]
+            name = Path(vf["rel"]).name
+            vfs.append({"vf": vf, "configuration": header.get("configuration", "default"),
+                        "listed": fmt_value(files_map.get(name)) if name in files_map else "n/a",
+                        "kinds": ", ".join(f"{k} {n}" for k, n in sorted(
+                            _count(it["kind"] or "(none)" for it in items).items())),
+                        "passed": sum(it["conformance"] == "passed" for it in items),
+                        "failed": sum(it["conformance"] in ("failure", "error") for it in items),
+                        "not_replayed": sum(it["conformance"] in ("not replayed", "skipped")
+                                            for it in items)})
+        mb["vector_files"] = vfs
+        mb["vector_totals"] = {k: sum(v[k] if k != "count" else v["vf"]["count"] for v in vfs)
+                               for k in ("count", "passed", "failed", "not_replayed")}
+        mb["vector_totals"]["steps"] = sum(v["vf"]["steps"] for v in vfs)
+        # conformance test files
+        mb["conformance"] = [tf for tf in self.test_files
+                             if "conformance_mb" in tf["rel"] or "moving_block" in tf["rel"]]
+        # scenarios
+        plots = dict(self.inp.scenario_plots)
+        scen, sweeps = [], []
+        for a in self.analyses:
+            d = a["data"]
+            schema = str(d.get("schema") or "")
+            if schema.startswith("railproof/sim-summary/"):
+                name = str(d.get("scenario") or a["stem"].removeprefix("scenario_"))
+                gap = d.get("gap") if isinstance(d.get("gap"), dict) else None
+                faults = [f for f in d.get("faults") or [] if isinstance(f, dict)]
+                trains = d.get("trains") if isinstance(d.get("trains"), list) else []
+                progress = d.get("progress") if isinstance(d.get("progress"), dict) else {}
+                scen.append({"name": name, "analysis": a["id"], "rel": a["rel"],
+                             "description": str(d.get("description") or ""),
+                             "line": str(d.get("line") or ""),
+                             "running_line": str(d.get("running_line") or ""),
+                             "assumption": str(d.get("line_assumption") or ""),
+                             "simulated_s": fmt_value(d.get("simulated_s")),
+                             "trains": len(trains),
+                             "train_km": fmt_value(progress.get("train_km")),
+                             "faults": ", ".join(f"{t} {n}" if n > 1 else t for t, n in
+                                                 _count(str(f.get("type", "?")) for f in faults).items())
+                             or "none",
+                             "violations": fmt_value(d.get("violations")),
+                             "result": str(d.get("result") or "n/a"),
+                             "gap": fmt_value(gap.get("settled_gap_m")) if gap else "n/a",
+                             "plot": name if name in plots else "",
+                             "log": self.inp.scenario_logs.get(name, "")})
+            elif schema.startswith("railproof/sim-sweep/"):
+                rows = []
+                for r in d.get("runs") or []:
+                    if not isinstance(r, dict):
+                        continue
+                    g = r.get("gap") if isinstance(r.get("gap"), dict) else {}
+                    rows.append([fmt_value(r.get("leader_cap_kmh")), str(r.get("result", "n/a")),
+                                 fmt_value(r.get("violations")),
+                                 fmt_value(g.get("leader_speed_kmh")),
+                                 fmt_value(g.get("follower_speed_kmh")),
+                                 fmt_value(g.get("settled_gap_m")), fmt_value(g.get("min_m")),
+                                 fmt_value(g.get("max_m")), fmt_value(g.get("window_s")),
+                                 fmt_value(g.get("samples"))])
+                sweeps.append({"analysis": a["id"], "rel": a["rel"],
+                               "scenario": str(d.get("scenario") or ""),
+                               "line": str(d.get("line") or ""), "rows": rows,
+                               "grows": fmt_value(d.get("gap_grows_with_speed")),
+                               "result": str(d.get("result") or "n/a")})
+        mb["scenarios"] = scen
+        mb["sweeps"] = sweeps
+        shown = {s["plot"] for s in scen if s["plot"]}
+        mb["plots"] = [{"name": n, "src": f"scenario_plots/{n}.svg",
+                        "scenario": next((s for s in scen if s["plot"] == n), None)}
+                       for n, _ in self.inp.scenario_plots]
+        mb["plots_without_summary"] = sorted(set(plots) - shown)
+        mb["present"] = bool(mb["requirements"] or model or cov or vfs or scen or plots)
+        self.mb = mb
 
     # -- tool versions --------------------------------------------------------------------
     def _versions(self):
@@ -1337,8 +1551,11 @@ def render_sources(model: Model, evidence_dir: Path, src_dir: Path) -> list:
                     ignore=shutil.ignore_patterns("templates", "__pycache__", "*.pyc", "_build",
                                                   "README.md"))
     env = _jinja_env(template_dir)
-    pages = ["overview", "traceability", "hazards", "model_checking", "test_generation",
-             "tests", "analysis", "tool_versions", "manifest"]
+    pages = ["overview", "traceability", "hazards", "model_checking", "moving_block",
+             "test_generation", "tests", "analysis", "tool_versions", "manifest"]
+    for name, path in model.inp.scenario_plots:     # embedded by the moving-block chapter
+        (src_dir / "scenario_plots").mkdir(parents=True, exist_ok=True)
+        shutil.copyfile(path, src_dir / "scenario_plots" / f"{name}.svg")
     ctx = {"m": model, "inp": model.inp}
     for page in pages:
         _write(src_dir / f"{page}.rst", env.get_template(f"{page}.rst.jinja").render(**ctx))

@@ -44,7 +44,7 @@ _RX = {
     "rep_in": re.compile(r"@IN report t=(\d+) front=(\d+) ext=(\d+)"),
     "rep_out": re.compile(r"@OUT report t=(\d+) tracked=(\d+)"),
     "tick_in": re.compile(r"@IN tick"),
-    "train_out": re.compile(r"@OUT train t=(\d+) grant=(-?\d+) why=(\d+) abn=(\d+)"),
+    "train_out": re.compile(r"@OUT train t=(\d+) grant=(-?\d+) why=(\d+) abn=(\d+) usable=(\d+)"),
     "il_out": re.compile(r"@OUT il main=(\d+) side=(\d+) pts=(\d+) poss=(\d+) occ=(\d+)"),
     "dl_in": re.compile(r"@IN deliver t=(\d+) lim=(-?\d+) age=(\d+)"),
     "dl_out": re.compile(r"@OUT ob t=(\d+) verdict=(\d+) lim=(-?\d+)"),
@@ -76,7 +76,8 @@ def parse_events(text: str):
             pending = None
         elif m := _RX["train_out"].search(line):
             _expect(pending, "tick", line)
-            trains.append({"t": int(m[1]), "grant": int(m[2]), "why": int(m[3]), "abn": int(m[4])})
+            trains.append({"t": int(m[1]), "grant": int(m[2]), "why": int(m[3]), "abn": int(m[4]),
+                           "usable": int(m[5])})
         elif m := _RX["il_out"].search(line):
             _expect(pending, "tick", line)
             events.append((pending, {"trains": trains, "main": int(m[1]), "side": int(m[2]),
@@ -129,7 +130,8 @@ def to_steps(events, sc: Scale):
                           "out": {"tracked": bool(o["tracked"])}})
         elif ev == "tick":
             trains = [{"limit_mm": sc.limit(t["grant"]) if t["abn"] else (t["grant"] + 1) * sc.S,
-                       "kind": KINDS[t["why"]], "abnormal": bool(t["abn"])}
+                       "kind": KINDS[t["why"]], "abnormal": bool(t["abn"]),
+                       "authority_usable": bool(t["usable"])}
                       for t in sorted(o["trains"], key=lambda x: x["t"])]
             occupied = [b for b in range(sc.b["blocks"]) if o["occ"] >> b & 1]
             steps.append({"in": {"ev": "tick"},

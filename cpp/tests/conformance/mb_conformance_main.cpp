@@ -14,7 +14,8 @@
 //   cmd      -> the ground command; expected: possession state, siding requested
 //   report   -> Ground::OnReport (front as block + offset); expected: accepted
 //   tick     -> clock += tick_ms, Ground::Cycle; expected: every train's limit, kind and
-//               tracking state, routes, points, possession, occupied blocks
+//               tracking state and whether its on-board authority is still usable,
+//               routes, points, possession, occupied blocks
 //   deliver  -> AuthorityReceiver::Receive(limit, now - age, now); expected: verdict, the
 //               on-board limit (null: nothing accepted yet)
 // On a mismatch the failure names the vector, the step, the field, expected and actual.
@@ -223,6 +224,7 @@ class VectorTest : public testing::Test {
     const Vector& v = g_vectors[index_];
     const Header& h = g_headers[v.header];
     g_replayed.fetch_add(1);
+    RecordProperty("vector_id", v.id);
     std::vector<std::string> problems;
     Replay(v, h, problems);
     if (!problems.empty()) {
@@ -344,6 +346,9 @@ class VectorTest : public testing::Test {
           expect(pre + "abnormal", trains[t].at("abnormal").get<bool>() ? "true" : "false", o->abnormal ? "true" : "false");
           expect(pre + "limit_mm", Opt(trains[t].at("limit_mm")), Opt(o->limit_mm));
           expect(pre + "kind", trains[t].at("kind").get<std::string>(), rw::ToString(o->kind));
+          // the on-board authority is still usable at this cycle (before its deliveries)
+          expect(pre + "authority_usable", trains[t].at("authority_usable").get<bool>() ? "true" : "false",
+                 onboard[t].Usable(now) ? "true" : "false");
         }
         expect("main_route", out.at("main_route").get<bool>() ? "set" : "unset", g.RouteSet(kMainRouteId) ? "set" : "unset");
         expect("siding_route", out.at("siding_route").get<bool>() ? "set" : "unset",

@@ -357,7 +357,7 @@ LoadResult LoadVectorDirectory(const std::filesystem::path& dir) {
   }
   std::sort(files.begin(), files.end());
   if (files.empty()) {
-    result.error = "no *.jsonl vector file (telegram*.jsonl) in " + dir.string();
+    result.error = "no *.jsonl vector file in " + dir.string() + " (telegram*.jsonl)";
     return result;
   }
   for (const auto& path : files) {
