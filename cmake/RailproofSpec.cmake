@@ -8,9 +8,13 @@ file(GLOB RAILPROOF_SPEC_FILES CONFIGURE_DEPENDS
   ${RAILPROOF_SOURCE_DIR}/spec/*/*.yaml ${RAILPROOF_SOURCE_DIR}/spec/schemas/*.json)
 file(GLOB RAILPROOF_TESTGEN_FILES CONFIGURE_DEPENDS ${RAILPROOF_SOURCE_DIR}/testgen/railproof_testgen/*.py)
 set(RAILPROOF_PARAM_HEADER ${RAILPROOF_GEN_INCLUDE}/railproof/generated/telegram_params.hpp
-    ${RAILPROOF_GEN_INCLUDE}/railproof/generated/moving_block_params.hpp)
+    ${RAILPROOF_GEN_INCLUDE}/railproof/generated/moving_block_params.hpp
+    ${RAILPROOF_GEN_INCLUDE}/railproof/generated/braking_params.hpp
+    ${RAILPROOF_GEN_INCLUDE}/railproof/generated/speed_check_params.hpp)
 set(RAILPROOF_PARAM_PML ${RAILPROOF_GEN_DIR}/models/telegram_params.pml
-    ${RAILPROOF_GEN_DIR}/models/moving_block_params.pml)
+    ${RAILPROOF_GEN_DIR}/models/moving_block_params.pml
+    ${RAILPROOF_GEN_DIR}/models/braking_params.pml
+    ${RAILPROOF_GEN_DIR}/models/speed_check_params.pml)
 add_custom_command(
   OUTPUT ${RAILPROOF_PARAM_HEADER} ${RAILPROOF_PARAM_PML}
   COMMAND ${RAILPROOF_TESTGEN} gen-params --spec ${RAILPROOF_SOURCE_DIR}/spec --out ${RAILPROOF_GEN_DIR}

@@ -28,7 +28,8 @@ def generate(spec_dir: Path, out_dir: Path):
     from .validate import validate_spec; validate_spec(spec_dir)  # noqa: E702
     areas = spec_mod.load_parameters(spec_dir)
     for area, data in sorted(areas.items()):
-        name = {"TG": "telegram", "MB": "moving_block"}.get(area, area.lower())
+        name = {"TG": "telegram", "MB": "moving_block", "BR": "braking",
+                "SC": "speed_check"}.get(area, area.lower())
         lines = [
             "// Generated from spec/parameters by railproof_testgen gen-params. Do not edit.",
             "#pragma once",

@@ -54,6 +54,7 @@ ID_TOKEN = re.compile(r"\b(?:REQ|HAZ|ASM|UR)-[A-Za-z0-9]+(?:-[A-Za-z0-9]+)*")
 # A source citation: D1-D5 with a section or chapter, an assumption, or a named standard.
 CITATION = re.compile(
     r"\bD[1-5]\s*(?:§\s*\d|chapters?\s+\d)"
+    r"|\bD3\b"  # D3 is a short article without numbered sections (digest §5)
     r"|\bASM-\d{3}\b"
     r"|\b(?:EN|IEC|ISO|IEEE|UIC|DIN|RFC|FIPS|CLC/TS|CLC/TR|ISO/IEC|NIST\s+SP)\s*[-:]?\s*\d"
     r"|\bMISRA\b")
