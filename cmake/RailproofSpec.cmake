@@ -38,3 +38,26 @@ add_custom_command(
   COMMENT "spec: validating spec/lines and writing the line JSON"
   VERBATIM)
 add_custom_target(railproof_gen_lines ALL DEPENDS ${RAILPROOF_LINE_JSON})
+
+# Train types (spec/trains/*.yaml and the negative-test types of spec/trains/mutants):
+# validated (schema, ranges, design rule REQ-BR-010) and converted to the JSON read by the
+# margin verification and the speed-check design tool (build/gen/trains).
+file(GLOB RAILPROOF_TRAIN_FILES CONFIGURE_DEPENDS ${RAILPROOF_SOURCE_DIR}/spec/trains/*.yaml)
+file(GLOB RAILPROOF_TRAIN_MUTANT_FILES CONFIGURE_DEPENDS ${RAILPROOF_SOURCE_DIR}/spec/trains/mutants/*.yaml)
+set(RAILPROOF_TRAIN_JSON)
+foreach(f ${RAILPROOF_TRAIN_FILES})
+  get_filename_component(n ${f} NAME_WE)
+  list(APPEND RAILPROOF_TRAIN_JSON ${RAILPROOF_GEN_DIR}/trains/${n}.json)
+endforeach()
+set(RAILPROOF_TRAIN_MUTANT_JSON)
+foreach(f ${RAILPROOF_TRAIN_MUTANT_FILES})
+  get_filename_component(n ${f} NAME_WE)
+  list(APPEND RAILPROOF_TRAIN_MUTANT_JSON ${RAILPROOF_GEN_DIR}/trains/mutants/${n}.json)
+endforeach()
+add_custom_command(
+  OUTPUT ${RAILPROOF_TRAIN_JSON} ${RAILPROOF_TRAIN_MUTANT_JSON}
+  COMMAND ${RAILPROOF_TESTGEN} trains --spec ${RAILPROOF_SOURCE_DIR}/spec --out ${RAILPROOF_GEN_DIR}/trains
+  DEPENDS ${RAILPROOF_TRAIN_FILES} ${RAILPROOF_TRAIN_MUTANT_FILES} ${RAILPROOF_SPEC_FILES} ${RAILPROOF_TESTGEN_FILES}
+  COMMENT "spec: validating spec/trains and writing the train JSON"
+  VERBATIM)
+add_custom_target(railproof_gen_trains ALL DEPENDS ${RAILPROOF_TRAIN_JSON} ${RAILPROOF_TRAIN_MUTANT_JSON})

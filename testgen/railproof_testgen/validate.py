@@ -245,6 +245,11 @@ def check_spec(spec_dir):
     line_outputs, line_refs = lines_mod.check_lines(spec_dir, report)
     model["lines"] = line_outputs
     refs.extend(line_refs)
+    # Train types (spec/trains, REQ-BR-010): schema, ranges and the pattern design rule.
+    from . import trains as trains_mod
+    train_outputs, train_refs = trains_mod.check_trains(spec_dir, report)
+    model["trains"] = {name: obj for (_m, name), obj in train_outputs.items()}
+    refs.extend(train_refs)
 
     _check_references(model, refs, report)
     _check_requirements(model, report)
@@ -255,7 +260,7 @@ def check_spec(spec_dir):
 
 def _empty_model():
     return {"requirements": {}, "hazards": {}, "assumptions": {}, "justifications": {},
-            "parameters": {}, "lines": {}}
+            "parameters": {}, "lines": {}, "trains": {}}
 
 
 def _collect_parameters(f, data, model, param_areas, refs, report):
@@ -374,7 +379,8 @@ def run(args):
         return 1
     print(f"validate: {args.spec} ok: {n['requirements']} requirements, {n['hazards']} hazards, "
           f"{n['assumptions']} assumptions, {n['parameters']} parameter file(s), "
-          f"{n['justifications']} justifications, {n['lines']} line(s); "
+          f"{n['justifications']} justifications, {n['lines']} line(s), "
+          f"{n['trains']} train type(s); "
           f"{len(report.warnings)} warning(s)")
     return 0
 

@@ -1,0 +1,159 @@
+"""Train types: validation of spec/trains/*.yaml and generation of the train JSON.
+
+Command ``trains --spec DIR --out DIR`` checks every ``spec/trains/*.yaml`` (and the
+deliberately weakened negative-test types of ``spec/trains/mutants/*.yaml``) against
+``spec/schemas/train.schema.json`` and the rules below, then writes ``OUT/<name>.json``
+and ``OUT/mutants/<name>.json`` (schema ``railproof/train-json/1``: the YAML's keys and
+integer values, read by the C++ margin verification and the speed-check design tool).
+Every finding is one line ``file: entry: reason``; with any error nothing is written and
+the exit status is 1. ``validate --spec`` runs the same checks on spec/trains/*.yaml.
+
+Rules after the schema:
+- ``name`` is the file name; every source cites D1-D5 §, an ASM or a standard; the
+  ``assumption`` exists;
+- every range ``[min, max]`` has min <= max;
+- design rule of the pattern decelerations (REQ-BR-010): the service pattern deceleration
+  does not exceed the emergency pattern deceleration, which does not exceed the lowest
+  real emergency deceleration. A negative-test type in ``mutants/`` may break this rule
+  (that is its purpose); its JSON lists the broken rules under ``design_rule_violations``
+  and the margin verification must fail on it.
+"""
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+from . import lines as lines_mod
+from . import spec as spec_mod
+from . import validate as vmod
+from .errors import SpecError
+
+SUB = "trains"
+MUTANTS = "mutants"
+SCHEMA_FILE = "train.schema.json"
+JSON_SCHEMA = "railproof/train-json/1"
+
+_RANGES = (("braking", "emergency_free_running_ms"), ("braking", "service_free_running_ms"),
+           ("uncertainty", "emergency_deceleration_mm_s2"),
+           ("uncertainty", "service_deceleration_mm_s2"))
+
+
+def design_rule_violations(data):
+    """Broken pattern-deceleration rules of REQ-BR-010 (list of reasons)."""
+    b, u = data["braking"], data["uncertainty"]
+    out = []
+    if b["service_pattern_mm_s2"] > b["emergency_pattern_mm_s2"]:
+        out.append(f"service pattern deceleration {b['service_pattern_mm_s2']} mm/s^2 exceeds "
+                   f"the emergency pattern deceleration {b['emergency_pattern_mm_s2']} mm/s^2 "
+                   "(REQ-BR-010)")
+    lowest = u["emergency_deceleration_mm_s2"][0]
+    if b["emergency_pattern_mm_s2"] > lowest:
+        out.append(f"emergency pattern deceleration {b['emergency_pattern_mm_s2']} mm/s^2 exceeds "
+                   f"the lowest real emergency deceleration {lowest} mm/s^2 (REQ-BR-010)")
+    return out
+
+
+def _check(f, data, report, mutant):
+    name = data["name"]
+    ok = True
+    if name != f.stem:
+        report.error(f, name, f"name {name!r} must equal the file name {f.stem!r}")
+        ok = False
+    for i, s in enumerate(data["source"]):
+        if not vmod.CITATION.search(s):
+            report.error(f, name, f"source[{i}] {s!r} cites no D1-D5 section, ASM-NNN or "
+                                  "named standard")
+            ok = False
+    for group, key in _RANGES:
+        lo, hi = data[group][key]
+        if lo > hi:
+            report.error(f, f"{group}.{key}", f"range [{lo}, {hi}] has min > max")
+            ok = False
+    broken = design_rule_violations(data)
+    if not mutant:
+        for reason in broken:
+            report.error(f, f"{name}.braking", reason)
+            ok = False
+    if not ok:
+        return None
+    obj = dict(data)
+    obj["schema"] = JSON_SCHEMA
+    if mutant:
+        obj["design_rule_violations"] = broken
+    return obj
+
+
+def check_trains(spec_dir, report, with_mutants=False):
+    """Check spec/trains (and mutants/ if asked) into `report`; returns (outputs, refs):
+    outputs maps (mutant, name) -> train JSON object of the files without errors."""
+    spec_dir = Path(spec_dir)
+    outputs, refs = {}, []
+    root = spec_dir / SUB
+    if not root.is_dir():
+        return outputs, refs
+    try:
+        validator = vmod._load_schema(spec_dir, SCHEMA_FILE)
+    except SpecError as exc:
+        report.error(exc.file, exc.entry, exc.reason)
+        return outputs, refs
+    groups = [(False, sorted(root.glob("*.yaml")))]
+    if with_mutants:
+        groups.append((True, sorted((root / MUTANTS).glob("*.yaml"))))
+    for mutant, files in groups:
+        for f in files:
+            try:
+                data = spec_mod.load_yaml(f)
+            except SpecError as exc:
+                report.error(exc.file, exc.entry, exc.reason)
+                continue
+            if lines_mod._schema_errors(validator, data, f, report):
+                continue
+            refs.append((f, data["name"], "assumption", data["assumption"]))
+            refs.extend((f, data["name"], f"source[{i}]", s) for i, s in enumerate(data["source"]))
+            obj = _check(f, data, report, mutant)
+            if obj is not None:
+                outputs[(mutant, data["name"])] = obj
+    return outputs, refs
+
+
+def build(spec_dir):
+    report = vmod.Report()
+    spec_dir = Path(spec_dir)
+    if not (spec_dir / SUB).is_dir():
+        report.error(spec_dir / SUB, "-", "train type directory not found")
+        return {}, report
+    outputs, refs = check_trains(spec_dir, report, with_mutants=True)
+    if not any(not m for m, _ in outputs) and not report.errors:
+        report.error(spec_dir / SUB, "-", "no train type files (*.yaml)")
+    known = lines_mod._known_assumptions(spec_dir, report)
+    if known is not None:
+        lines_mod.check_refs(refs, known, report)
+    return outputs, report
+
+
+def run(args):
+    spec_dir, out_dir = Path(args.spec), Path(args.out)
+    outputs, report = build(spec_dir)
+    report.print()
+    if report.errors:
+        print(f"trains: {len(report.errors)} error(s) in {spec_dir / SUB}; nothing written",
+              file=sys.stderr)
+        return 1
+    for (mutant, name), obj in sorted(outputs.items()):
+        path = out_dir / (MUTANTS if mutant else "") / f"{name}.json"
+        lines_mod._write(path, lines_mod.render(obj))
+        print(f"trains: {'negative-test ' if mutant else ''}{name} -> {path}")
+    return 0
+
+
+def register(sub):
+    p = sub.add_parser(
+        "trains", help="validate spec/trains and write the train JSON",
+        description="Check every spec/trains/*.yaml and spec/trains/mutants/*.yaml against "
+                    "spec/schemas/train.schema.json and the design rule REQ-BR-010 (not "
+                    "enforced for the negative-test types in mutants/), then write "
+                    "OUT/<name>.json and OUT/mutants/<name>.json (schema "
+                    "railproof/train-json/1). On any error nothing is written, exit 1.")
+    p.add_argument("--spec", required=True, help="spec/ directory")
+    p.add_argument("--out", required=True, help="output directory (build/gen/trains)")
+    p.set_defaults(func=run)
