@@ -114,7 +114,53 @@ if(TARGET line_sim)
   list(APPEND _scenario_outputs ${_sweep})
 endif()
 
-add_custom_target(railproof_analysis_results ALL DEPENDS ${_residual} ${_scenario_outputs})
+# Braking (spec/design/braking.md): the D3 speed-check design, the worst-case margin
+# verification over every line and train type (Ipopt, grid/corner, OMPL falsifier; exits
+# non-zero naming the location of any negative margin) and the SMT proofs (z3 and cvc5).
+set(_braking_outputs)
+set(_braking_dir ${RAILPROOF_RESULTS_DIR}/braking)
+if(TARGET speedcheck_design)
+  set(_sc ${RAILPROOF_RESULTS_DIR}/analysis/speed_check_design.json)
+  add_custom_command(
+    OUTPUT ${_sc} ${_braking_dir}/speed_check_design.svg
+    COMMAND ${CMAKE_COMMAND} -E make_directory ${RAILPROOF_RESULTS_DIR}/analysis ${_braking_dir}
+    COMMAND speedcheck_design --json ${_sc} --svg ${_braking_dir}/speed_check_design.svg
+            --train-json ${RAILPROOF_TRAIN_JSON}
+    DEPENDS speedcheck_design ${RAILPROOF_TRAIN_JSON}
+    COMMENT "analysis: two-counter speed-check design (D3)" VERBATIM)
+  list(APPEND _braking_outputs ${_sc})
+endif()
+if(TARGET margins)
+  set(_margins ${RAILPROOF_RESULTS_DIR}/analysis/margins.json)
+  set(_margin_lines)
+  foreach(l ${RAILPROOF_LINE_JSON})
+    list(APPEND _margin_lines --line ${l})
+  endforeach()
+  set(_margin_trains)
+  foreach(t ${RAILPROOF_TRAIN_JSON})
+    list(APPEND _margin_trains --train ${t})
+  endforeach()
+  add_custom_command(
+    OUTPUT ${_margins}
+    COMMAND ${CMAKE_COMMAND} -E make_directory ${RAILPROOF_RESULTS_DIR}/analysis ${_braking_dir}
+    COMMAND margins ${_margin_lines} ${_margin_trains} --json ${_margins} --svg-dir ${_braking_dir}
+    DEPENDS margins ${RAILPROOF_LINE_JSON} ${RAILPROOF_TRAIN_JSON}
+    COMMENT "analysis: worst-case braking margins (every line x train type)" USES_TERMINAL VERBATIM)
+  list(APPEND _braking_outputs ${_margins})
+endif()
+file(GLOB_RECURSE _proof_sources CONFIGURE_DEPENDS ${RAILPROOF_SOURCE_DIR}/proofs/*)
+if(EXISTS ${RAILPROOF_SOURCE_DIR}/testgen/railproof_testgen/proofs.py)
+  set(_proofs ${RAILPROOF_RESULTS_DIR}/proofs/braking.json)
+  add_custom_command(
+    OUTPUT ${_proofs}
+    COMMAND ${RAILPROOF_TESTGEN} proofs --spec ${RAILPROOF_SOURCE_DIR}/spec
+            --proofs ${RAILPROOF_SOURCE_DIR}/proofs --out ${RAILPROOF_RESULTS_DIR}/proofs
+    DEPENDS ${_proof_sources} ${RAILPROOF_SPEC_FILES} ${RAILPROOF_TESTGEN_FILES}
+    COMMENT "proofs: SMT obligations from spec/ replayed by z3 and cvc5" USES_TERMINAL VERBATIM)
+  list(APPEND _braking_outputs ${_proofs})
+endif()
+
+add_custom_target(railproof_analysis_results ALL DEPENDS ${_residual} ${_scenario_outputs} ${_braking_outputs})
 
 set(_tools ${RAILPROOF_RESULTS_DIR}/tool-versions.json)
 add_custom_command(
@@ -130,7 +176,8 @@ add_custom_command(
   OUTPUT ${_trace}
   COMMAND ${RAILPROOF_TESTGEN} trace --spec ${RAILPROOF_SOURCE_DIR}/spec --src ${RAILPROOF_SOURCE_DIR}
           --results ${RAILPROOF_RESULTS_DIR} --out ${_trace}
-  DEPENDS ${_spin_outputs} ${_vector_outputs} ${_residual} ${_scenario_outputs} ${_traced_sources} ${RAILPROOF_SPEC_FILES}
+  DEPENDS ${_spin_outputs} ${_vector_outputs} ${_residual} ${_scenario_outputs} ${_braking_outputs}
+          ${_traced_sources} ${_proof_sources} ${RAILPROOF_SPEC_FILES}
   COMMENT "trace: requirement <-> property/vector/code/test links" VERBATIM)
 
 set(_manifest ${CMAKE_BINARY_DIR}/evidence/manifest.json)
@@ -139,7 +186,8 @@ add_custom_command(
   OUTPUT ${_manifest}
   COMMAND ${RAILPROOF_TESTGEN} evidence --spec ${RAILPROOF_SOURCE_DIR}/spec --results ${RAILPROOF_RESULTS_DIR}
           --src ${RAILPROOF_SOURCE_DIR} --out ${CMAKE_BINARY_DIR}/evidence --tool-versions ${_tools}
-  DEPENDS ${_trace} ${_evidence_tests} ${_residual} ${_scenario_outputs} ${_tools} ${_evidence_sources}
+  DEPENDS ${_trace} ${_evidence_tests} ${_residual} ${_scenario_outputs} ${_braking_outputs} ${_tools}
+          ${_evidence_sources}
   COMMENT "evidence: rendering the assessor's package (Sphinx + sphinx-needs)" USES_TERMINAL VERBATIM)
 add_custom_target(evidence DEPENDS ${_manifest})
 

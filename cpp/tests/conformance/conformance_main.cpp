@@ -24,11 +24,14 @@
 #include <utility>
 #include <vector>
 
+#include "runner_cli.hpp"
 #include "railproof/radio/aead.hpp"
 #include "railproof/radio/endpoint.hpp"
 #include "railproof/radio/frame.hpp"
 #include "railproof/radio/telegram.hpp"
 #include "vector_reader.hpp"
+
+namespace rcli = railproof::conformance;
 
 namespace {
 
@@ -255,47 +258,11 @@ void Usage(std::FILE* out) {
 int main(int argc, char** argv) {
   // Own flags first; everything else goes to GoogleTest (--junit becomes --gtest_output,
   // which GoogleTest reads during InitGoogleTest).
-  std::string vectors_dir;
-  std::string junit;
-  std::vector<std::string> gtest_args = {argc > 0 ? argv[0] : "railproof_conformance"};
-  for (int i = 1; i < argc; ++i) {
-    const std::string arg = argv[i];
-    if (arg == "--help" || arg == "-h") {
-      Usage(stdout);
-      return 0;
-    }
-    if ((arg == "--vectors" || arg == "--junit") && i + 1 < argc) {
-      (arg == "--vectors" ? vectors_dir : junit) = argv[++i];
-    } else if (arg.rfind("--vectors=", 0) == 0) {
-      vectors_dir = arg.substr(std::strlen("--vectors="));
-    } else if (arg.rfind("--junit=", 0) == 0) {
-      junit = arg.substr(std::strlen("--junit="));
-    } else if (arg.rfind("--gtest_", 0) == 0) {
-      gtest_args.push_back(arg);
-    } else {
-      std::fprintf(stderr, "railproof-conformance: error: unknown or incomplete argument \"%s\" (see --help)\n",
-                   arg.c_str());
-      return 2;
-    }
+  const rcli::RunnerArgs args = rcli::ParseArgsAndInitGoogleTest("railproof-conformance", argc, argv, Usage);
+  if (args.exit_code >= 0) {
+    return args.exit_code;
   }
-  if (vectors_dir.empty()) {
-    std::fprintf(stderr, "railproof-conformance: error: --vectors DIR is required (see --help)\n");
-    return 2;
-  }
-  if (!junit.empty()) {
-    gtest_args.push_back("--gtest_output=xml:" + junit);
-  }
-  std::vector<char*> gtest_argv;
-  for (std::string& a : gtest_args) {
-    gtest_argv.push_back(a.data());
-  }
-  gtest_argv.push_back(nullptr);
-  int gtest_argc = static_cast<int>(gtest_args.size());
-  testing::InitGoogleTest(&gtest_argc, gtest_argv.data());
-  if (gtest_argc > 1) {
-    std::fprintf(stderr, "railproof-conformance: error: unknown GoogleTest flag \"%s\"\n", gtest_argv[1]);
-    return 2;
-  }
+  const std::string& vectors_dir = args.vectors_dir;
 
   rc::LoadResult loaded = rc::LoadVectorDirectory(vectors_dir);
   std::size_t files = 0;
@@ -320,27 +287,7 @@ int main(int argc, char** argv) {
     testing::RegisterTest("TelegramConformance", v.test_name.c_str(), nullptr, nullptr, v.file.c_str(),
                           static_cast<int>(v.line), [i]() -> testing::Test* { return new VectorTest(i); });
   }
-  if (!loaded.ok) {
-    std::fprintf(stderr, "railproof-conformance: error: %s\n", loaded.error.c_str());
-  } else {
-    std::printf("railproof-conformance: %zu vectors from %zu file(s) in %s\n", vector_count, files,
-                vectors_dir.c_str());
-  }
-
+  rcli::ReportLoad("railproof-conformance", loaded.ok, loaded.error, vector_count, files, vectors_dir);
   const int rc_tests = RUN_ALL_TESTS();
-  if (!loaded.ok) {
-    std::printf("railproof-conformance: error: %s\n", loaded.error.c_str());
-    return 1;
-  }
-  const std::size_t bad = g_mismatched.load();
-  if (bad > 0) {
-    std::printf("railproof-conformance: vectors mismatched: %zu of %zu\n", bad, g_replayed.load());
-    return 1;
-  }
-  if (rc_tests != 0) {
-    std::printf("railproof-conformance: error: test run failed\n");
-    return 1;
-  }
-  std::printf("railproof-conformance: all %zu vectors passed (%zu in the set)\n", g_replayed.load(), vector_count);
-  return 0;
+  return rcli::Finish("railproof-conformance", loaded.ok, loaded.error, g_mismatched.load(), g_replayed.load(), vector_count, rc_tests);
 }

@@ -39,8 +39,11 @@
 #include <utility>
 #include <vector>
 
+#include "runner_cli.hpp"
 #include "railproof/onboard/authority.hpp"
 #include "railproof/wayside/ground.hpp"
+
+namespace rcli = railproof::conformance;
 
 namespace {
 
@@ -412,39 +415,11 @@ void Usage(std::FILE* f) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string vectors_dir;
-  std::string junit;
-  std::vector<std::string> gtest_args = {argc > 0 ? argv[0] : "railproof_conformance_mb"};
-  for (int i = 1; i < argc; ++i) {
-    const std::string arg = argv[i];
-    if (arg == "--help" || arg == "-h") {
-      Usage(stdout);
-      return 0;
-    }
-    if ((arg == "--vectors" || arg == "--junit") && i + 1 < argc) {
-      (arg == "--vectors" ? vectors_dir : junit) = argv[++i];
-    } else if (arg.rfind("--gtest_", 0) == 0) {
-      gtest_args.push_back(arg);
-    } else {
-      std::fprintf(stderr, "railproof-conformance-mb: error: unknown or incomplete argument \"%s\" (see --help)\n",
-                   arg.c_str());
-      return 2;
-    }
+  const rcli::RunnerArgs args = rcli::ParseArgsAndInitGoogleTest("railproof-conformance-mb", argc, argv, Usage);
+  if (args.exit_code >= 0) {
+    return args.exit_code;
   }
-  if (vectors_dir.empty()) {
-    std::fprintf(stderr, "railproof-conformance-mb: error: --vectors DIR is required (see --help)\n");
-    return 2;
-  }
-  if (!junit.empty()) {
-    gtest_args.push_back("--gtest_output=xml:" + junit);
-  }
-  std::vector<char*> gtest_argv;
-  for (std::string& a : gtest_args) {
-    gtest_argv.push_back(a.data());
-  }
-  gtest_argv.push_back(nullptr);
-  int gtest_argc = static_cast<int>(gtest_args.size());
-  testing::InitGoogleTest(&gtest_argc, gtest_argv.data());
+  const std::string& vectors_dir = args.vectors_dir;
 
   std::string error;
   const bool ok = Load(vectors_dir, error);
@@ -461,25 +436,7 @@ int main(int argc, char** argv) {
                           g_headers[v.header].file.c_str(), static_cast<int>(v.line),
                           [i]() -> testing::Test* { return new VectorTest(i); });
   }
-  if (!ok) {
-    std::fprintf(stderr, "railproof-conformance-mb: error: %s\n", error.c_str());
-  } else {
-    std::printf("railproof-conformance-mb: %zu vectors from %zu file(s) in %s\n", n, files.size(), vectors_dir.c_str());
-  }
+  rcli::ReportLoad("railproof-conformance-mb", ok, error, n, files.size(), vectors_dir);
   const int rc_tests = RUN_ALL_TESTS();
-  if (!ok) {
-    std::printf("railproof-conformance-mb: error: %s\n", error.c_str());
-    return 1;
-  }
-  const std::size_t bad = g_mismatched.load();
-  if (bad > 0) {
-    std::printf("railproof-conformance-mb: vectors mismatched: %zu of %zu\n", bad, g_replayed.load());
-    return 1;
-  }
-  if (rc_tests != 0) {
-    std::printf("railproof-conformance-mb: error: test run failed\n");
-    return 1;
-  }
-  std::printf("railproof-conformance-mb: all %zu vectors passed (%zu in the set)\n", g_replayed.load(), n);
-  return 0;
+  return rcli::Finish("railproof-conformance-mb", ok, error, g_mismatched.load(), g_replayed.load(), n, rc_tests);
 }

@@ -1,0 +1,106 @@
+// Command line and exit protocol shared by the conformance runners
+// (railproof_conformance, railproof_conformance_mb, railproof_conformance_br):
+//   <runner> --vectors DIR [--junit FILE] [--gtest_* flags]
+// Exit status 0 if every vector passed, 1 if not (or no usable vector set), 2 on bad
+// arguments. The last line printed is one of
+//   "<prog>: all N vectors passed (M in the set)"
+//   "<prog>: vectors mismatched: K of N"      (the seeded-fault tests look for K > 0)
+//   "<prog>: error: <reason>"
+#pragma once
+
+#include <gtest/gtest.h>
+
+#include <cstddef>
+#include <cstdio>
+#include <cstring>
+#include <string>
+#include <vector>
+
+namespace railproof::conformance {
+
+struct RunnerArgs {
+  std::string vectors_dir;
+  int exit_code = -1;  // >= 0: main returns it at once (--help, bad arguments)
+};
+
+// Reads the runner's own flags, passes --gtest_* flags (and --junit as --gtest_output) to
+// GoogleTest and initialises it.
+inline RunnerArgs ParseArgsAndInitGoogleTest(const char* prog, int argc, char** argv,
+                                             void (*usage)(std::FILE*)) {
+  RunnerArgs out;
+  std::string junit;
+  std::vector<std::string> gtest_args = {argc > 0 ? argv[0] : prog};
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (arg == "--help" || arg == "-h") {
+      usage(stdout);
+      out.exit_code = 0;
+      return out;
+    }
+    if ((arg == "--vectors" || arg == "--junit") && i + 1 < argc) {
+      (arg == "--vectors" ? out.vectors_dir : junit) = argv[++i];
+    } else if (arg.rfind("--vectors=", 0) == 0) {
+      out.vectors_dir = arg.substr(std::strlen("--vectors="));
+    } else if (arg.rfind("--junit=", 0) == 0) {
+      junit = arg.substr(std::strlen("--junit="));
+    } else if (arg.rfind("--gtest_", 0) == 0) {
+      gtest_args.push_back(arg);
+    } else {
+      std::fprintf(stderr, "%s: error: unknown or incomplete argument \"%s\" (see --help)\n", prog,
+                   arg.c_str());
+      out.exit_code = 2;
+      return out;
+    }
+  }
+  if (out.vectors_dir.empty()) {
+    std::fprintf(stderr, "%s: error: --vectors DIR is required (see --help)\n", prog);
+    out.exit_code = 2;
+    return out;
+  }
+  if (!junit.empty()) {
+    gtest_args.push_back("--gtest_output=xml:" + junit);
+  }
+  std::vector<char*> gtest_argv;
+  for (std::string& a : gtest_args) {
+    gtest_argv.push_back(a.data());
+  }
+  gtest_argv.push_back(nullptr);
+  int gtest_argc = static_cast<int>(gtest_args.size());
+  testing::InitGoogleTest(&gtest_argc, gtest_argv.data());
+  if (gtest_argc > 1) {
+    std::fprintf(stderr, "%s: error: unknown GoogleTest flag \"%s\"\n", prog, gtest_argv[1]);
+    out.exit_code = 2;
+  }
+  return out;
+}
+
+// Prints the load result before the run (vector count or the error).
+inline void ReportLoad(const char* prog, bool ok, const std::string& error, std::size_t vectors,
+                       std::size_t files, const std::string& dir) {
+  if (!ok) {
+    std::fprintf(stderr, "%s: error: %s\n", prog, error.c_str());
+  } else {
+    std::printf("%s: %zu vectors from %zu file(s) in %s\n", prog, vectors, files, dir.c_str());
+  }
+}
+
+// The exit protocol after RUN_ALL_TESTS (see the file comment).
+inline int Finish(const char* prog, bool ok, const std::string& error, std::size_t mismatched,
+                  std::size_t replayed, std::size_t in_set, int rc_tests) {
+  if (!ok) {
+    std::printf("%s: error: %s\n", prog, error.c_str());
+    return 1;
+  }
+  if (mismatched > 0) {
+    std::printf("%s: vectors mismatched: %zu of %zu\n", prog, mismatched, replayed);
+    return 1;
+  }
+  if (rc_tests != 0) {
+    std::printf("%s: error: test run failed\n", prog);
+    return 1;
+  }
+  std::printf("%s: all %zu vectors passed (%zu in the set)\n", prog, replayed, in_set);
+  return 0;
+}
+
+}  // namespace railproof::conformance
