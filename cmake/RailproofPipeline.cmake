@@ -67,6 +67,17 @@ if(TARGET railproof_conformance_mb)
     USES_TERMINAL VERBATIM)
   list(APPEND _evidence_tests ${_tests_dir}/conformance_mb.xml)
 endif()
+if(TARGET railproof_conformance_br)
+  add_custom_command(
+    OUTPUT ${_tests_dir}/conformance_br.xml
+    COMMAND ${CMAKE_COMMAND} -E make_directory ${_tests_dir}
+    COMMAND railproof_conformance_br --vectors ${RAILPROOF_VECTOR_DIR}
+            --gtest_output=xml:${_tests_dir}/conformance_br.xml
+    DEPENDS railproof_conformance_br ${_vector_outputs}
+    COMMENT "tests: braking-supervision conformance replay -> results/tests/conformance_br.xml"
+    USES_TERMINAL VERBATIM)
+  list(APPEND _evidence_tests ${_tests_dir}/conformance_br.xml)
+endif()
 add_custom_command(
   OUTPUT ${_tests_dir}/testgen.xml
   COMMAND ${CMAKE_COMMAND} -E make_directory ${_tests_dir}
@@ -120,12 +131,16 @@ endif()
 set(_braking_outputs)
 set(_braking_dir ${RAILPROOF_RESULTS_DIR}/braking)
 if(TARGET speedcheck_design)
+  set(_sc_trains)
+  foreach(t ${RAILPROOF_TRAIN_JSON})
+    list(APPEND _sc_trains --train-json ${t})
+  endforeach()
   set(_sc ${RAILPROOF_RESULTS_DIR}/analysis/speed_check_design.json)
   add_custom_command(
     OUTPUT ${_sc} ${_braking_dir}/speed_check_design.svg
     COMMAND ${CMAKE_COMMAND} -E make_directory ${RAILPROOF_RESULTS_DIR}/analysis ${_braking_dir}
     COMMAND speedcheck_design --json ${_sc} --svg ${_braking_dir}/speed_check_design.svg
-            --train-json ${RAILPROOF_TRAIN_JSON}
+            ${_sc_trains}
     DEPENDS speedcheck_design ${RAILPROOF_TRAIN_JSON}
     COMMENT "analysis: two-counter speed-check design (D3)" VERBATIM)
   list(APPEND _braking_outputs ${_sc})
