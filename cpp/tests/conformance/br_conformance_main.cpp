@@ -1,0 +1,324 @@
+// railproof_conformance_br: replays the vectors generated from models/braking.pml (every
+// braking*.jsonl of the vector directory) against the C++ speed-supervision decision
+// braking::Supervisor (railproof_braking), spec/design/braking.md §4. One GoogleTest test
+// per vector, named BrakingConformance.<file>_<vector id>, plus BrakingConformance.VectorSet,
+// which fails if the vector set is missing, empty or malformed.
+//
+//   railproof_conformance_br --vectors DIR [--junit FILE] [gtest flags]
+//
+// Each vector starts from a fresh Supervisor (nothing latched, no level applied). Each step
+// is one cycle: the inputs v_s, v_e, v_7n, v_6n, v_5n, v_4n, v_release (the model's abstract
+// speeds, fed unchanged as mm/s: the decision only compares them, header "units") and
+// standstill, handle_emergency, reset go to Supervisor::Step; expected: the level, the
+// "pattern approaching" indication and whether the emergency brake is latched (in the
+// Decision and in Supervisor::emergency_latched()). On a mismatch the failure names the
+// vector, the step, the field, expected and actual.
+// Last line: "railproof-conformance-br: all N vectors passed" or
+// "railproof-conformance-br: vectors mismatched: K of N" or "...: error: <reason>".
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cstdint>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "railproof/braking/supervisor.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+namespace rb = railproof::braking;
+using json = nlohmann::json;
+
+constexpr const char* kModel = "models/braking.pml";
+constexpr const char* kUnits = "abstract speed units = mm/s";
+
+struct Vector {
+  std::string id;
+  std::string test_name;
+  std::string file;
+  std::size_t line = 0;
+  json steps;
+};
+
+std::vector<Vector> g_vectors;
+std::set<std::string> g_files;
+std::atomic<std::size_t> g_mismatched{0};
+std::atomic<std::size_t> g_replayed{0};
+
+std::string Sanitize(const std::string& s) {
+  std::string out = s;
+  for (char& c : out) {
+    if (!((c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9'))) {
+      c = '_';
+    }
+  }
+  return out;
+}
+
+// Checks the shape of one step (the schema is checked when the vectors are written; this
+// guards the harness against a hand-edited or truncated file).
+bool StepWellFormed(const json& step) {
+  if (!step.is_object() || !step.contains("in") || !step.contains("out")) {
+    return false;
+  }
+  const json& in = step["in"];
+  const json& out = step["out"];
+  for (const char* k : {"v_s", "v_e", "v_7n", "v_6n", "v_5n", "v_4n", "v_release"}) {
+    if (!in.contains(k) || !in[k].is_number_integer()) {
+      return false;
+    }
+  }
+  for (const char* k : {"standstill", "handle_emergency", "reset"}) {
+    if (!in.contains(k) || !in[k].is_boolean()) {
+      return false;
+    }
+  }
+  return out.contains("level") && out["level"].is_string() && out.contains("pattern_approaching") &&
+         out["pattern_approaching"].is_boolean() && out.contains("emergency_latched") &&
+         out["emergency_latched"].is_boolean();
+}
+
+// Loads every braking*.jsonl of dir; an error names the file and line.
+bool Load(const fs::path& dir, std::string& error) {
+  std::error_code ec;
+  if (!fs::is_directory(dir, ec)) {
+    error = "vector directory " + dir.string() + " does not exist";
+    return false;
+  }
+  std::vector<fs::path> files;
+  for (const auto& e : fs::directory_iterator(dir, ec)) {
+    const std::string name = e.path().filename().string();
+    if (e.is_regular_file() && e.path().extension() == ".jsonl" && name.rfind("braking", 0) == 0) {
+      files.push_back(e.path());
+    }
+  }
+  std::sort(files.begin(), files.end());
+  if (files.empty()) {
+    error = "no braking*.jsonl vector file in " + dir.string();
+    return false;
+  }
+  for (const fs::path& f : files) {
+    std::ifstream in(f);
+    std::string text;
+    std::size_t n = 0;
+    bool have_header = false;
+    while (std::getline(in, text)) {
+      ++n;
+      const std::string where = f.filename().string() + ":" + std::to_string(n);
+      if (text.empty()) {
+        continue;
+      }
+      json obj = json::parse(text, nullptr, false);
+      if (obj.is_discarded() || !obj.is_object()) {
+        error = where + ": not a JSON object";
+        return false;
+      }
+      if (!have_header) {
+        if (obj.value("kind", "") != "header" || obj.value("model", "") != kModel ||
+            !obj.contains("parameters")) {
+          error = where + ": first line is not a " + std::string(kModel) + " vector header";
+          return false;
+        }
+        if (obj.value("units", "") != kUnits) {
+          error = where + ": header units must be \"" + std::string(kUnits) + "\"";
+          return false;
+        }
+        have_header = true;
+        g_files.insert(f.filename().string());
+        continue;
+      }
+      if (!obj.contains("id") || !obj["id"].is_string() || !obj.contains("steps") || !obj["steps"].is_array() ||
+          obj["steps"].empty()) {
+        error = where + ": vector needs an id and a non-empty steps list";
+        return false;
+      }
+      for (const json& s : obj["steps"]) {
+        if (!StepWellFormed(s)) {
+          error = where + ": malformed step in vector " + obj["id"].get<std::string>();
+          return false;
+        }
+      }
+      Vector v;
+      v.id = obj["id"].get<std::string>();
+      v.test_name = Sanitize(f.stem().string() + "_" + v.id);
+      v.file = f.filename().string();
+      v.line = n;
+      v.steps = obj["steps"];
+      for (const Vector& o : g_vectors) {
+        if (o.test_name == v.test_name) {
+          error = where + ": duplicate vector id " + v.id;
+          return false;
+        }
+      }
+      g_vectors.push_back(std::move(v));
+    }
+    if (!have_header) {
+      error = f.filename().string() + ": empty file (no header)";
+      return false;
+    }
+  }
+  if (g_vectors.empty()) {
+    error = "no vector in the " + std::to_string(files.size()) + " braking*.jsonl file(s) of " + dir.string();
+    return false;
+  }
+  return true;
+}
+
+const char* Bool(bool b) { return b ? "true" : "false"; }
+
+class VectorTest : public testing::Test {
+ public:
+  explicit VectorTest(std::size_t index) : index_(index) {}
+  void TestBody() override {
+    const Vector& v = g_vectors[index_];
+    g_replayed.fetch_add(1);
+    RecordProperty("vector_id", v.id);
+    std::vector<std::string> problems;
+    Replay(v, problems);
+    if (!problems.empty()) {
+      g_mismatched.fetch_add(1);
+    }
+    for (const std::string& p : problems) {
+      ADD_FAILURE_AT(v.file.c_str(), static_cast<int>(v.line)) << "vector " << v.id << ": " << p;
+    }
+  }
+
+ private:
+  static void Replay(const Vector& v, std::vector<std::string>& problems) {
+    rb::Supervisor sup;
+    for (std::size_t k = 0; k < v.steps.size() && problems.empty(); ++k) {
+      const json& in = v.steps[k].at("in");
+      const json& out = v.steps[k].at("out");
+      rb::PatternSpeeds p;
+      p.v_s = in.at("v_s").get<std::int64_t>();
+      p.v_e = in.at("v_e").get<std::int64_t>();
+      p.v_7n = in.at("v_7n").get<std::int64_t>();
+      p.v_6n = in.at("v_6n").get<std::int64_t>();
+      p.v_5n = in.at("v_5n").get<std::int64_t>();
+      p.v_4n = in.at("v_4n").get<std::int64_t>();
+      p.v_release = in.at("v_release").get<std::int64_t>();
+      rb::DriverInputs d;
+      d.standstill = in.at("standstill").get<bool>();
+      d.handle_emergency = in.at("handle_emergency").get<bool>();
+      d.reset = in.at("reset").get<bool>();
+      const rb::Decision got = sup.Step(p, d);
+      auto expect = [&](const std::string& field, const std::string& expected, const std::string& actual) {
+        if (expected != actual) {
+          problems.push_back("step " + std::to_string(k) + " (cycle " + std::to_string(k + 1) + "): " + field +
+                             " expected " + expected + ", got " + actual + " [inputs " + in.dump() + "]");
+        }
+      };
+      expect("level", out.at("level").get<std::string>(), rb::ToString(got.level));
+      expect("pattern_approaching", Bool(out.at("pattern_approaching").get<bool>()), Bool(got.pattern_approaching));
+      expect("emergency_latched", Bool(out.at("emergency_latched").get<bool>()), Bool(got.emergency_latched));
+      expect("Supervisor::emergency_latched()", Bool(out.at("emergency_latched").get<bool>()),
+             Bool(sup.emergency_latched()));
+    }
+  }
+
+  std::size_t index_;
+};
+
+class VectorSetTest : public testing::Test {
+ public:
+  VectorSetTest(std::string error, std::size_t files, std::size_t vectors)
+      : error_(std::move(error)), files_(files), vectors_(vectors) {}
+  void TestBody() override {
+    ASSERT_TRUE(error_.empty()) << error_;
+    EXPECT_GT(files_, 0U);
+    EXPECT_GT(vectors_, 0U);
+  }
+
+ private:
+  std::string error_;
+  std::size_t files_;
+  std::size_t vectors_;
+};
+
+void Usage(std::FILE* f) {
+  std::fprintf(f,
+               "usage: railproof_conformance_br --vectors DIR [--junit FILE] [gtest flags]\n"
+               "Replays every braking*.jsonl vector of DIR against the C++ speed-supervision decision\n"
+               "(braking::Supervisor). Exit 0 only if every vector matches.\n");
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string vectors_dir;
+  std::string junit;
+  std::vector<std::string> gtest_args = {argc > 0 ? argv[0] : "railproof_conformance_br"};
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (arg == "--help" || arg == "-h") {
+      Usage(stdout);
+      return 0;
+    }
+    if ((arg == "--vectors" || arg == "--junit") && i + 1 < argc) {
+      (arg == "--vectors" ? vectors_dir : junit) = argv[++i];
+    } else if (arg.rfind("--gtest_", 0) == 0) {
+      gtest_args.push_back(arg);
+    } else {
+      std::fprintf(stderr, "railproof-conformance-br: error: unknown or incomplete argument \"%s\" (see --help)\n",
+                   arg.c_str());
+      return 2;
+    }
+  }
+  if (vectors_dir.empty()) {
+    std::fprintf(stderr, "railproof-conformance-br: error: --vectors DIR is required (see --help)\n");
+    return 2;
+  }
+  if (!junit.empty()) {
+    gtest_args.push_back("--gtest_output=xml:" + junit);
+  }
+  std::vector<char*> gtest_argv;
+  for (std::string& a : gtest_args) {
+    gtest_argv.push_back(a.data());
+  }
+  gtest_argv.push_back(nullptr);
+  int gtest_argc = static_cast<int>(gtest_args.size());
+  testing::InitGoogleTest(&gtest_argc, gtest_argv.data());
+
+  std::string error;
+  const bool ok = Load(vectors_dir, error);
+  const std::size_t n = ok ? g_vectors.size() : 0;
+  testing::RegisterTest("BrakingConformance", "VectorSet", nullptr, nullptr, __FILE__, __LINE__,
+                        [error, nfiles = g_files.size(), n]() -> testing::Test* {
+                          return new VectorSetTest(error, nfiles, n);
+                        });
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vector& v = g_vectors[i];
+    testing::RegisterTest("BrakingConformance", v.test_name.c_str(), nullptr, nullptr, v.file.c_str(),
+                          static_cast<int>(v.line), [i]() -> testing::Test* { return new VectorTest(i); });
+  }
+  if (!ok) {
+    std::fprintf(stderr, "railproof-conformance-br: error: %s\n", error.c_str());
+  } else {
+    std::printf("railproof-conformance-br: %zu vectors from %zu file(s) in %s\n", n, g_files.size(),
+                vectors_dir.c_str());
+  }
+  const int rc_tests = RUN_ALL_TESTS();
+  if (!ok) {
+    std::printf("railproof-conformance-br: error: %s\n", error.c_str());
+    return 1;
+  }
+  const std::size_t bad = g_mismatched.load();
+  if (bad > 0) {
+    std::printf("railproof-conformance-br: vectors mismatched: %zu of %zu\n", bad, g_replayed.load());
+    return 1;
+  }
+  if (rc_tests != 0) {
+    std::printf("railproof-conformance-br: error: test run failed\n");
+    return 1;
+  }
+  std::printf("railproof-conformance-br: all %zu vectors passed (%zu in the set)\n", g_replayed.load(), n);
+  return 0;
+}
