@@ -30,6 +30,9 @@
 #include <vector>
 
 #include "railproof/braking/supervisor.hpp"
+#include "runner_cli.hpp"
+
+namespace rcli = railproof::conformance;
 
 namespace {
 
@@ -253,42 +256,12 @@ void Usage(std::FILE* f) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string vectors_dir;
-  std::string junit;
-  std::vector<std::string> gtest_args = {argc > 0 ? argv[0] : "railproof_conformance_br"};
-  for (int i = 1; i < argc; ++i) {
-    const std::string arg = argv[i];
-    if (arg == "--help" || arg == "-h") {
-      Usage(stdout);
-      return 0;
-    }
-    if ((arg == "--vectors" || arg == "--junit") && i + 1 < argc) {
-      (arg == "--vectors" ? vectors_dir : junit) = argv[++i];
-    } else if (arg.rfind("--gtest_", 0) == 0) {
-      gtest_args.push_back(arg);
-    } else {
-      std::fprintf(stderr, "railproof-conformance-br: error: unknown or incomplete argument \"%s\" (see --help)\n",
-                   arg.c_str());
-      return 2;
-    }
+  const rcli::RunnerArgs args = rcli::ParseArgsAndInitGoogleTest("railproof-conformance-br", argc, argv, Usage);
+  if (args.exit_code >= 0) {
+    return args.exit_code;
   }
-  if (vectors_dir.empty()) {
-    std::fprintf(stderr, "railproof-conformance-br: error: --vectors DIR is required (see --help)\n");
-    return 2;
-  }
-  if (!junit.empty()) {
-    gtest_args.push_back("--gtest_output=xml:" + junit);
-  }
-  std::vector<char*> gtest_argv;
-  for (std::string& a : gtest_args) {
-    gtest_argv.push_back(a.data());
-  }
-  gtest_argv.push_back(nullptr);
-  int gtest_argc = static_cast<int>(gtest_args.size());
-  testing::InitGoogleTest(&gtest_argc, gtest_argv.data());
-
   std::string error;
-  const bool ok = Load(vectors_dir, error);
+  const bool ok = Load(args.vectors_dir, error);
   const std::size_t n = ok ? g_vectors.size() : 0;
   testing::RegisterTest("BrakingConformance", "VectorSet", nullptr, nullptr, __FILE__, __LINE__,
                         [error, nfiles = g_files.size(), n]() -> testing::Test* {
@@ -299,26 +272,7 @@ int main(int argc, char** argv) {
     testing::RegisterTest("BrakingConformance", v.test_name.c_str(), nullptr, nullptr, v.file.c_str(),
                           static_cast<int>(v.line), [i]() -> testing::Test* { return new VectorTest(i); });
   }
-  if (!ok) {
-    std::fprintf(stderr, "railproof-conformance-br: error: %s\n", error.c_str());
-  } else {
-    std::printf("railproof-conformance-br: %zu vectors from %zu file(s) in %s\n", n, g_files.size(),
-                vectors_dir.c_str());
-  }
+  rcli::ReportLoad("railproof-conformance-br", ok, error, n, g_files.size(), args.vectors_dir);
   const int rc_tests = RUN_ALL_TESTS();
-  if (!ok) {
-    std::printf("railproof-conformance-br: error: %s\n", error.c_str());
-    return 1;
-  }
-  const std::size_t bad = g_mismatched.load();
-  if (bad > 0) {
-    std::printf("railproof-conformance-br: vectors mismatched: %zu of %zu\n", bad, g_replayed.load());
-    return 1;
-  }
-  if (rc_tests != 0) {
-    std::printf("railproof-conformance-br: error: test run failed\n");
-    return 1;
-  }
-  std::printf("railproof-conformance-br: all %zu vectors passed (%zu in the set)\n", g_replayed.load(), n);
-  return 0;
+  return rcli::Finish("railproof-conformance-br", ok, error, g_mismatched.load(), g_replayed.load(), n, rc_tests);
 }
