@@ -21,12 +21,11 @@ import shutil
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
-import jsonschema
-
 from . import __version__
 from . import spin as spin_mod
 from .errors import PipelineError, SpecError
-from .vectors import _atomic_write, load_justifications, search_goal, write_goals_file
+from .vectors import (_atomic_write, load_justifications, schema_checked_jsonl, search_goal,
+                      write_goals_file)
 
 # braking::BrakeLevel in order, named as braking::ToString
 LEVELS = ["NONE", "4N", "5N", "6N", "7N", "EB"]
@@ -104,17 +103,6 @@ def header_for(model: Path, b: dict):
 def _bounds(params_pml: Path):
     raw = spin_mod.read_bounds(params_pml)
     return {k[len("model_"):] if k.startswith("model_") else k: v for k, v in raw.items()}
-
-
-def schema_checked_jsonl(schema_path: Path, lines, name: str) -> str:
-    """Validate every line against the schema and return the JSON Lines text."""
-    validator = jsonschema.Draft202012Validator(json.loads(Path(schema_path).read_text(encoding="utf-8")))
-    for n, obj in enumerate(lines, 1):
-        err = next(iter(validator.iter_errors(obj)), None)
-        if err:
-            raise PipelineError(f"generated {name} line {n} violates the vector schema: "
-                                f"{'/'.join(map(str, err.path))}: {err.message}")
-    return "".join(json.dumps(o, sort_keys=True, separators=(",", ":")) + "\n" for o in lines)
 
 
 def _progress(msg):

@@ -15,12 +15,11 @@ import shutil
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
-import jsonschema
-
 from . import __version__
 from . import spin as spin_mod
 from .errors import PipelineError, SpecError
-from .vectors import _atomic_write, load_justifications, search_goal, write_goals_file
+from .vectors import (_atomic_write, load_justifications, schema_checked_jsonl, search_goal,
+                      write_goals_file)
 
 NOTEL = -9
 KINDS = ["NONE", "PRECEDING_TRAIN", "FIXED_BLOCK", "ROUTE_END", "HANDOVER", "SYSTEM_BOUNDARY",
@@ -307,16 +306,9 @@ def generate(model: Path, params_dir: Path, spec_dir: Path, workdir: Path, out_d
     vectors.extend(per_config.pop(None, []))
     vectors.sort(key=lambda v: (v["kind"] == "random", v["id"]))
 
-    schema = json.loads((Path(spec_dir) / "schemas" / "vectors_moving_block.schema.json").read_text(encoding="utf-8"))
-    validator = jsonschema.Draft202012Validator(schema)
-
     def checked(lines, name):
-        for n, obj in enumerate(lines, 1):
-            err = next(iter(validator.iter_errors(obj)), None)
-            if err:
-                raise PipelineError(f"generated {name} line {n} violates the vector schema: "
-                                    f"{'/'.join(map(str, err.path))}: {err.message}")
-        return "".join(json.dumps(o, sort_keys=True, separators=(",", ":")) + "\n" for o in lines)
+        return schema_checked_jsonl(
+            Path(spec_dir) / "schemas" / "vectors_moving_block.schema.json", lines, name)
 
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)

@@ -310,16 +310,8 @@ def generate(model: Path, params_dir: Path, spec_dir: Path, workdir: Path, out_d
             "init_own_seq": bounds["init_own_seq"], "init_peer_seq": bounds["init_peer_seq"],
             **ids},
     }
-    schema = json.loads((Path(spec_dir) / "schemas" / "vectors.schema.json").read_text(encoding="utf-8"))
-    validator = jsonschema.Draft202012Validator(schema)
-
     def checked(lines, name):
-        for n, obj in enumerate(lines, 1):
-            err = next(iter(validator.iter_errors(obj)), None)
-            if err:
-                raise PipelineError(f"generated {name} line {n} violates the vector schema: "
-                                    f"{'/'.join(map(str, err.path))}: {err.message}")
-        return "".join(json.dumps(o, sort_keys=True, separators=(",", ":")) + "\n" for o in lines)
+        return schema_checked_jsonl(Path(spec_dir) / "schemas" / "vectors.schema.json", lines, name)
 
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
@@ -347,6 +339,20 @@ def generate(model: Path, params_dir: Path, spec_dir: Path, workdir: Path, out_d
     if problems:
         raise PipelineError(f"{model.name}: " + "; ".join(problems))
     return cov
+
+
+def schema_checked_jsonl(schema_path: Path, lines, name: str) -> str:
+    """Validate every line (header and vectors) against the JSON schema of the vector
+    format and return the JSON Lines text; a line that violates it is a PipelineError naming
+    the file, line and field (nothing is written). Shared by every vector generator."""
+    schema = json.loads(Path(schema_path).read_text(encoding="utf-8"))
+    validator = jsonschema.Draft202012Validator(schema)
+    for n, obj in enumerate(lines, 1):
+        err = next(iter(validator.iter_errors(obj)), None)
+        if err:
+            raise PipelineError(f"generated {name} line {n} violates the vector schema: "
+                                f"{'/'.join(map(str, err.path))}: {err.message}")
+    return "".join(json.dumps(o, sort_keys=True, separators=(",", ":")) + "\n" for o in lines)
 
 
 def _atomic_write(path: Path, text: str):
