@@ -30,6 +30,7 @@
 #include <vector>
 
 #include "railproof/braking/supervisor.hpp"
+#include "jsonl_vectors.hpp"
 #include "runner_cli.hpp"
 
 namespace rcli = railproof::conformance;
@@ -56,16 +57,6 @@ std::set<std::string> g_files;
 std::atomic<std::size_t> g_mismatched{0};
 std::atomic<std::size_t> g_replayed{0};
 
-std::string Sanitize(const std::string& s) {
-  std::string out = s;
-  for (char& c : out) {
-    if (!((c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9'))) {
-      c = '_';
-    }
-  }
-  return out;
-}
-
 // Checks the shape of one step (the schema is checked when the vectors are written; this
 // guards the harness against a hand-edited or truncated file).
 bool StepWellFormed(const json& step) {
@@ -91,88 +82,30 @@ bool StepWellFormed(const json& step) {
 
 // Loads every braking*.jsonl of dir; an error names the file and line.
 bool Load(const fs::path& dir, std::string& error) {
-  std::error_code ec;
-  if (!fs::is_directory(dir, ec)) {
-    error = "vector directory " + dir.string() + " does not exist";
-    return false;
-  }
-  std::vector<fs::path> files;
-  for (const auto& e : fs::directory_iterator(dir, ec)) {
-    const std::string name = e.path().filename().string();
-    if (e.is_regular_file() && e.path().extension() == ".jsonl" && name.rfind("braking", 0) == 0) {
-      files.push_back(e.path());
-    }
-  }
-  std::sort(files.begin(), files.end());
-  if (files.empty()) {
-    error = "no braking*.jsonl vector file in " + dir.string();
-    return false;
-  }
-  for (const fs::path& f : files) {
-    std::ifstream in(f);
-    std::string text;
-    std::size_t n = 0;
-    bool have_header = false;
-    while (std::getline(in, text)) {
-      ++n;
-      const std::string where = f.filename().string() + ":" + std::to_string(n);
-      if (text.empty()) {
-        continue;
-      }
-      json obj = json::parse(text, nullptr, false);
-      if (obj.is_discarded() || !obj.is_object()) {
-        error = where + ": not a JSON object";
-        return false;
-      }
-      if (!have_header) {
-        if (obj.value("kind", "") != "header" || obj.value("model", "") != kModel ||
-            !obj.contains("parameters")) {
-          error = where + ": first line is not a " + std::string(kModel) + " vector header";
-          return false;
+  std::size_t files = 0;
+  error = rcli::ReadVectorDirectory(
+      dir, "braking",
+      [](const std::string& file, const json& obj) -> std::string {
+        if (obj.value("kind", "") != "header" || obj.value("model", "") != kModel || !obj.contains("parameters")) {
+          return "first line is not a " + std::string(kModel) + " vector header";
         }
         if (obj.value("units", "") != kUnits) {
-          error = where + ": header units must be \"" + std::string(kUnits) + "\"";
-          return false;
+          return "header units must be \"" + std::string(kUnits) + "\"";
         }
-        have_header = true;
-        g_files.insert(f.filename().string());
-        continue;
-      }
-      if (!obj.contains("id") || !obj["id"].is_string() || !obj.contains("steps") || !obj["steps"].is_array() ||
-          obj["steps"].empty()) {
-        error = where + ": vector needs an id and a non-empty steps list";
-        return false;
-      }
-      for (const json& s : obj["steps"]) {
-        if (!StepWellFormed(s)) {
-          error = where + ": malformed step in vector " + obj["id"].get<std::string>();
-          return false;
+        g_files.insert(file);
+        return "";
+      },
+      [](const rcli::VectorLine& line) -> std::string {
+        for (const json& step : (*line.obj)["steps"]) {
+          if (!StepWellFormed(step)) {
+            return "malformed step in vector " + line.id;
+          }
         }
-      }
-      Vector v;
-      v.id = obj["id"].get<std::string>();
-      v.test_name = Sanitize(f.stem().string() + "_" + v.id);
-      v.file = f.filename().string();
-      v.line = n;
-      v.steps = obj["steps"];
-      for (const Vector& o : g_vectors) {
-        if (o.test_name == v.test_name) {
-          error = where + ": duplicate vector id " + v.id;
-          return false;
-        }
-      }
-      g_vectors.push_back(std::move(v));
-    }
-    if (!have_header) {
-      error = f.filename().string() + ": empty file (no header)";
-      return false;
-    }
-  }
-  if (g_vectors.empty()) {
-    error = "no vector in the " + std::to_string(files.size()) + " braking*.jsonl file(s) of " + dir.string();
-    return false;
-  }
-  return true;
+        g_vectors.push_back(Vector{line.id, line.test_name, line.file, line.line, (*line.obj)["steps"]});
+        return "";
+      },
+      files);
+  return error.empty();
 }
 
 const char* Bool(bool b) { return b ? "true" : "false"; }

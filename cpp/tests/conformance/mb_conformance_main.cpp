@@ -39,6 +39,7 @@
 #include <utility>
 #include <vector>
 
+#include "jsonl_vectors.hpp"
 #include "runner_cli.hpp"
 #include "railproof/onboard/authority.hpp"
 #include "railproof/wayside/ground.hpp"
@@ -76,91 +77,34 @@ std::vector<Vector> g_vectors;
 std::atomic<std::size_t> g_mismatched{0};
 std::atomic<std::size_t> g_replayed{0};
 
-std::string Sanitize(const std::string& s) {
-  std::string out = s;
-  for (char& c : out) {
-    if (!((c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9'))) {
-      c = '_';
-    }
-  }
-  return out;
-}
 
 // Loads every moving_block*.jsonl of dir; error names file and line.
 bool Load(const fs::path& dir, std::string& error) {
-  std::error_code ec;
-  if (!fs::is_directory(dir, ec)) {
-    error = "vector directory " + dir.string() + " does not exist";
-    return false;
-  }
-  std::vector<fs::path> files;
-  for (const auto& e : fs::directory_iterator(dir, ec)) {
-    const std::string name = e.path().filename().string();
-    if (e.is_regular_file() && e.path().extension() == ".jsonl" && name.rfind("moving_block", 0) == 0) {
-      files.push_back(e.path());
-    }
-  }
-  std::sort(files.begin(), files.end());
-  if (files.empty()) {
-    error = "no *.jsonl vector file (moving_block*.jsonl) in " + dir.string();
-    return false;
-  }
-  for (const fs::path& f : files) {
-    std::ifstream in(f);
-    std::string text;
-    std::size_t n = 0;
-    bool have_header = false;
-    while (std::getline(in, text)) {
-      ++n;
-      const std::string where = f.filename().string() + ":" + std::to_string(n);
-      json obj = json::parse(text, nullptr, false);
-      if (obj.is_discarded() || !obj.is_object()) {
-        error = where + ": not a JSON object";
-        return false;
-      }
-      if (!have_header) {
+  std::size_t files = 0;
+  error = rcli::ReadVectorDirectory(
+      dir, "moving_block",
+      [](const std::string& file, const json& obj) -> std::string {
         if (obj.value("kind", "") != "header" || obj.value("model", "") != "models/moving_block.pml" ||
             !obj.contains("parameters") || !obj.contains("unit_scales")) {
-          error = where + ": first line is not a models/moving_block.pml vector header";
-          return false;
+          return "first line is not a models/moving_block.pml vector header";
         }
         Header h;
-        h.file = f.filename().string();
+        h.file = file;
         h.configuration = obj.value("configuration", "default");
         h.tick_ms = obj["unit_scales"].value("time_ms_per_tick", std::int64_t{0});
         h.p = obj["parameters"];
         if (h.tick_ms <= 0) {
-          error = where + ": unit_scales.time_ms_per_tick must be positive";
-          return false;
+          return "unit_scales.time_ms_per_tick must be positive";
         }
         g_headers.push_back(std::move(h));
-        have_header = true;
-        continue;
-      }
-      if (!obj.contains("id") || !obj.contains("steps") || !obj["steps"].is_array() || obj["steps"].empty()) {
-        error = where + ": vector without id or steps";
-        return false;
-      }
-      Vector v;
-      v.id = obj["id"].get<std::string>();
-      v.test_name = Sanitize(f.stem().string() + "_" + v.id);
-      v.header = g_headers.size() - 1;
-      v.line = n;
-      v.steps = obj["steps"];
-      for (const Vector& o : g_vectors) {
-        if (o.test_name == v.test_name) {
-          error = where + ": duplicate vector id " + v.id;
-          return false;
-        }
-      }
-      g_vectors.push_back(std::move(v));
-    }
-  }
-  if (g_vectors.empty()) {
-    error = "no vector in the " + std::to_string(files.size()) + " moving_block*.jsonl file(s) of " + dir.string();
-    return false;
-  }
-  return true;
+        return "";
+      },
+      [](const rcli::VectorLine& line) -> std::string {
+        g_vectors.push_back(Vector{line.id, line.test_name, g_headers.size() - 1, line.line, (*line.obj)["steps"]});
+        return "";
+      },
+      files);
+  return error.empty();
 }
 
 // The model's line as a ground configuration (design note §2 mapping).
