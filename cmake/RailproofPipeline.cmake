@@ -158,7 +158,8 @@ if(TARGET margins)
   add_custom_command(
     OUTPUT ${_margins}
     COMMAND ${CMAKE_COMMAND} -E make_directory ${RAILPROOF_RESULTS_DIR}/analysis ${_braking_dir}
-    COMMAND margins ${_margin_lines} ${_margin_trains} --json ${_margins} --svg-dir ${_braking_dir}
+    COMMAND margins ${_margin_lines} ${_margin_trains} --json ${_margins}
+            --details ${_braking_dir}/margins_locations.json --svg-dir ${_braking_dir}
     DEPENDS margins ${RAILPROOF_LINE_JSON} ${RAILPROOF_TRAIN_JSON}
     COMMENT "analysis: worst-case braking margins (every line x train type)" USES_TERMINAL VERBATIM)
   list(APPEND _braking_outputs ${_margins})
@@ -216,3 +217,19 @@ add_test(NAME traceability
 add_test(NAME spec_validate
   COMMAND ${RAILPROOF_TESTGEN} validate --spec ${RAILPROOF_SOURCE_DIR}/spec)
 set_tests_properties(testgen_pytest traceability spec_validate PROPERTIES LABELS pipeline)
+
+# Negative test of the margin verification (REQ-BR-009): the deliberately weakened train
+# type of spec/trains/mutants must fail loudly, naming the location.
+if(TARGET margins)
+  set(_weak ${RAILPROOF_GEN_DIR}/trains/mutants/emu3_d1_weak.json)
+  add_test(NAME margins_fails_on_weakened_train
+    COMMAND margins --line ${RAILPROOF_GEN_DIR}/lines/d1_test_line.json --train ${_weak}
+            --json ${CMAKE_BINARY_DIR}/ctest-margins-weak.json --falsify-budget-s 0.2 --quiet)
+  set_tests_properties(margins_fails_on_weakened_train PROPERTIES LABELS "analysis;seeded_fault"
+    WILL_FAIL TRUE)
+  add_test(NAME margins_names_the_location_on_weakened_train
+    COMMAND margins --line ${RAILPROOF_GEN_DIR}/lines/d1_test_line.json --train ${_weak}
+            --json ${CMAKE_BINARY_DIR}/ctest-margins-weak2.json --falsify-budget-s 0 --quiet)
+  set_tests_properties(margins_names_the_location_on_weakened_train PROPERTIES LABELS "analysis;seeded_fault"
+    PASS_REGULAR_EXPRESSION "NEGATIVE MARGIN: line d1_test_line, running line (up|down), train emu3_d1_weak, class [a-z_]+, id '[^']+', stop limit at [0-9.]+ m, margin -[0-9.]+ m")
+endif()

@@ -559,7 +559,7 @@ std::int64_t PatternCalculator::SpeedAt(const Query& q, std::int64_t y) const no
     return u * u <= w;
   };
   if (!passes(0)) {
-    return 0;
+    return kNoPermittedSpeed;  // not even standing is permitted: hold the brake
   }
   std::int64_t lo = 0;                        // passes
   std::int64_t hi = params_.max_speed_mm_s;   // candidate
@@ -585,9 +585,9 @@ std::int64_t PatternCalculator::SupervisedSpeed(std::int64_t v_m, bool standstil
     v = v < -kMaxMeasuredSpeedMmS ? kMaxMeasuredSpeedMmS : -v;
   }
   v = std::min(v, kMaxMeasuredSpeedMmS);
-  if (v == 0 && standstill) {
-    return 0;
-  }
+  // The allowance is added at standstill too: a train creeping below the speed resolution
+  // reads 0 (and may even report standstill) while its true speed is up to the allowance.
+  (void)standstill;
 #if defined(FAULT_BR_NO_SPEED_ALLOWANCE)
   return v;
 #else
@@ -606,7 +606,7 @@ std::int64_t PatternCalculator::PatternSpeed(Pattern pattern, std::int64_t super
                      InRange(front_error_mm, 0, kMaxPositionErrorMm) &&
                      InRange(rear_error_mm, 0, kMaxPositionErrorMm);
   if (!valid) {
-    return 0;
+    return kNoPermittedSpeed;
   }
   Query q;
   q.pattern = pattern;
@@ -635,8 +635,9 @@ Evaluation PatternCalculator::Evaluate(const PositionEstimate& position,
   }
   const std::int64_t v_s = SupervisedSpeed(position.speed_mm_s, position.standstill);
   if (out.status != EvalStatus::kOk) {
-    out.speeds = PatternSpeeds{};
-    out.speeds.v_s = std::max<std::int64_t>(v_s, 1);  // fail-safe: emergency brake
+    // fail-safe: no speed permitted, so the emergency brake is commanded (and held)
+    out.speeds = PatternSpeeds{v_s, kNoPermittedSpeed, kNoPermittedSpeed, kNoPermittedSpeed,
+                               kNoPermittedSpeed, kNoPermittedSpeed, kNoPermittedSpeed};
     return out;
   }
   out.speeds.v_s = v_s;

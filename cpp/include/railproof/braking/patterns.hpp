@@ -265,13 +265,15 @@ class PatternCalculator {
                                     std::optional<std::int64_t> stop_limit_mm) const noexcept;
 
   // ---- helpers for the offline analysis (same integer arithmetic as Evaluate) ----------
-  // v_s = v_m + ceil(v_m * speed_error_ppm / 1e6) + speed_error_abs_mm_s; 0 when v_m == 0
-  // and standstill (REQ-BR-007). v_m < 0 is taken by magnitude, capped at kMaxMeasuredSpeedMmS.
+  // v_s = v_m + ceil(v_m * speed_error_ppm / 1e6) + speed_error_abs_mm_s, at standstill too
+  // (REQ-BR-007: a train creeping below the speed resolution reads 0). v_m < 0 is taken by
+  // magnitude, capped at kMaxMeasuredSpeedMmS. `standstill` is accepted for interface
+  // stability and does not change the result.
   [[nodiscard]] std::int64_t SupervisedSpeed(std::int64_t v_m, bool standstill = false) const noexcept;
   // Pattern speed at the supervised front y to the stop limit L (service: the stop target
   // is L - service_offset_mm). A restriction [b, e) is a ceiling for supervised fronts in
-  // [b, e + length + front_error + rear_error). 0 without a profile or with an argument
-  // out of range.
+  // [b, e + length + front_error + rear_error). kNoPermittedSpeed (-1) where not even
+  // standing is permitted, without a profile or with an argument out of range.
   [[nodiscard]] std::int64_t PatternSpeed(Pattern pattern, std::int64_t supervised_front_mm,
                                           std::int64_t stop_limit_mm, std::int64_t front_error_mm = 0,
                                           std::int64_t rear_error_mm = 0) const noexcept;

@@ -26,6 +26,12 @@ constexpr const char* ToString(BrakeLevel l) noexcept {
   return "INVALID";
 }
 
+// A pattern speed of kNoPermittedSpeed means that not even standing is permitted at that
+// point (the run-up from rest already reaches the target, or the input was invalid): every
+// supervised speed, 0 included, exceeds it, so a standing train is held by the brake and a
+// creeping train whose measured speed reads 0 is braked (design note §3).
+inline constexpr std::int64_t kNoPermittedSpeed = -1;
+
 // The supervised speed and the pattern speeds of one cycle (design note §3), mm/s:
 //   v_s        measured speed plus the speed-measurement allowance
 //   v_e        emergency pattern at the supervised front

@@ -388,13 +388,13 @@ TEST(BrakingPatternsFlat, StopPatternEqualsClosedFormFloor) {
     const std::int64_t vn = c.ServicePatternSpeed(y, limit);
     const double rn = std::min(vmax, ClosedForm(930, 890, 2'800, 0, static_cast<double>(d - 10'000)));
     if (re < 0) {
-      EXPECT_EQ(ve, 0) << d;
+      EXPECT_EQ(ve, kNoPermittedSpeed) << d;
     } else {
       EXPECT_LE(static_cast<double>(ve), re) << d;
       EXPECT_GE(ve, static_cast<std::int64_t>(std::floor(re)) - 1) << d;
     }
     if (rn < 0 || d < 10'000) {
-      EXPECT_EQ(vn, 0) << d;
+      EXPECT_EQ(vn, kNoPermittedSpeed) << d;
     } else {
       EXPECT_LE(static_cast<double>(vn), rn) << d;
       EXPECT_GE(vn, static_cast<std::int64_t>(std::floor(rn)) - 1) << d;
@@ -408,10 +408,10 @@ TEST(BrakingPatternsFlat, StopPatternEqualsClosedFormFloor) {
 // @verifies REQ-BR-002
 TEST(BrakingPatternsFlat, NothingPermittedAtOrBeyondTheStopTarget) {
   const PatternCalculator c = MakeWith({}, {});
-  EXPECT_EQ(c.EmergencyPatternSpeed(2'000'000, 2'000'000), 0);
-  EXPECT_EQ(c.EmergencyPatternSpeed(2'000'001, 2'000'000), 0);
-  EXPECT_EQ(c.ServicePatternSpeed(1'990'000, 2'000'000), 0);
-  EXPECT_EQ(c.ServicePatternSpeed(1'995'000, 2'000'000), 0);
+  EXPECT_EQ(c.EmergencyPatternSpeed(2'000'000, 2'000'000), kNoPermittedSpeed);
+  EXPECT_EQ(c.EmergencyPatternSpeed(2'000'001, 2'000'000), kNoPermittedSpeed);
+  EXPECT_EQ(c.ServicePatternSpeed(1'990'000, 2'000'000), kNoPermittedSpeed);
+  EXPECT_EQ(c.ServicePatternSpeed(1'995'000, 2'000'000), kNoPermittedSpeed);
   // far away: capped at max_speed_mm_s
   EXPECT_EQ(c.EmergencyPatternSpeed(0, 5'000'000), params::braking::max_speed_mm_s);
 }
@@ -564,13 +564,13 @@ TEST(BrakingPatternsRestriction, LowestOfSeveralRestrictions) {
 
 // ---- supervised speed, standstill, one cycle ------------------------------------------
 
-// v_s = v_m + ceil(v_m * 2500 / 1e6) + 174; 0 only at standstill.
+// v_s = v_m + ceil(v_m * 2500 / 1e6) + 174, at standstill too (a creeping train reads 0).
 // @verifies REQ-BR-007
 TEST(BrakingPatternsSpeed, SupervisedSpeedAddsTheAllowance) {
   const PatternCalculator c = MakeWith({}, {});
   EXPECT_EQ(c.SupervisedSpeed(20'000), 20'000 + 50 + 174);
   EXPECT_EQ(c.SupervisedSpeed(20'001), 20'001 + 51 + 174);  // 50.0025 rounded up
-  EXPECT_EQ(c.SupervisedSpeed(0, true), 0);
+  EXPECT_EQ(c.SupervisedSpeed(0, true), 174);
   EXPECT_EQ(c.SupervisedSpeed(0, false), 174);
   EXPECT_EQ(c.SupervisedSpeed(10, true), 10 + 1 + 174);
   EXPECT_EQ(c.SupervisedSpeed(-20'000), 20'000 + 50 + 174);
@@ -578,28 +578,48 @@ TEST(BrakingPatternsSpeed, SupervisedSpeedAddsTheAllowance) {
   EXPECT_EQ(e.speeds.v_s, 30'000 + 75 + 174);
 }
 
-// Without a usable stop limit the stop limit is the supervised front: every pattern is 0,
-// any movement (v_s > 0) commands the emergency brake, standstill does not.
+// A train standing closer to its stop limit than the run-up from rest (cycle, reaction and
+// free-running time at full traction, then braking) must not start: the emergency pattern
+// permits nothing there, so the brake is held at standstill (found by the worst-case margin
+// analysis: with a pattern speed of 0 such a train could restart and overrun by ~5 m).
+// @verifies REQ-BR-001 REQ-BR-009
+TEST(BrakingPatternsStandstill, NoRestartWithinTheRunUpOfTheStopLimit) {
+  const PatternCalculator c = MakeWith({}, {});
+  const std::int64_t limit = 2'000'000;
+  // run-up from rest: a = 930, T = 1.8 s: d_T = 1,507 mm, v_T = 1,674 mm/s, braking
+  // 1,674^2 / (2 * 990) = 1,416 mm: nothing is permitted within about 2.9 m of L
+  EXPECT_EQ(c.EmergencyPatternSpeed(limit - 2'800, limit), kNoPermittedSpeed);
+  EXPECT_GE(c.EmergencyPatternSpeed(limit - 3'000, limit), 0);
+  const Evaluation e = c.Evaluate(PositionEstimate{limit - 2'800, 0, 0, 0, true}, limit);
+  Supervisor sup;
+  EXPECT_EQ(sup.Step(e.speeds, DriverInputs{true, false, false}).level, BrakeLevel::kEmergency);
+}
+
+// Without a usable stop limit the stop limit is the supervised front: no speed is permitted
+// (not even standing, since a start would run up beyond it), so the emergency brake is
+// commanded and held, at standstill too (REQ-BR-012).
 // @verifies REQ-BR-012
 TEST(BrakingPatternsStandstill, NoStopLimitSupervisesStandstill) {
   const PatternCalculator c = MakeWith({}, {{0, 10'000'000, 30'000}});
   PositionEstimate pos{500'000, 1'000, 1'000, 0, true};
   Evaluation e = c.Evaluate(pos, std::nullopt);
   ASSERT_EQ(e.status, EvalStatus::kOk);
-  EXPECT_EQ(e.speeds.v_s, 0);
-  EXPECT_EQ(e.speeds.v_e, 0);
-  EXPECT_EQ(e.speeds.v_7n, 0);
-  EXPECT_EQ(e.speeds.v_release, 0);
+  EXPECT_EQ(e.speeds.v_s, 174);
+  EXPECT_EQ(e.speeds.v_e, kNoPermittedSpeed);
+  EXPECT_EQ(e.speeds.v_7n, kNoPermittedSpeed);
+  EXPECT_EQ(e.speeds.v_release, kNoPermittedSpeed);
   Supervisor sup;
-  EXPECT_EQ(sup.Step(e.speeds, DriverInputs{true, false, false}).level, BrakeLevel::kNone);
+  EXPECT_EQ(sup.Step(e.speeds, DriverInputs{true, false, false}).level, BrakeLevel::kEmergency);
+  // standstill, handle and reset release the latch, but the brake is commanded again at once
+  EXPECT_EQ(sup.Step(e.speeds, DriverInputs{true, true, true}).level, BrakeLevel::kEmergency);
   pos.standstill = false;  // speed zero but not yet for the standstill time
   e = c.Evaluate(pos, std::nullopt);
   EXPECT_EQ(e.speeds.v_s, 174);
-  EXPECT_EQ(e.speeds.v_e, 0);
+  EXPECT_EQ(e.speeds.v_e, kNoPermittedSpeed);
   EXPECT_EQ(sup.Step(e.speeds, DriverInputs{}).level, BrakeLevel::kEmergency);
   pos.speed_mm_s = 1'000;
   e = c.Evaluate(pos, std::nullopt);
-  EXPECT_EQ(e.speeds.v_e, 0);
+  EXPECT_EQ(e.speeds.v_e, kNoPermittedSpeed);
   EXPECT_GT(e.speeds.v_s, e.speeds.v_e);
   // with a stop limit far ahead the same train may run
   e = c.Evaluate(pos, 3'000'000);
@@ -637,16 +657,17 @@ TEST(BrakingPatternsEvaluate, LeadPointsUseTheServicePatternAhead) {
   EXPECT_GT(e0.speeds.v_e, e.speeds.v_e);
 }
 
-// Invalid inputs and a missing profile: typed status, pattern speeds 0 and v_s >= 1 so the
-// supervisor commands the emergency brake.
+// Invalid inputs and a missing profile: typed status, no pattern speed permitted
+// (kNoPermittedSpeed), so the supervisor commands the emergency brake, at standstill too.
 // @verifies REQ-BR-008
 TEST(BrakingPatternsEvaluate, InvalidInputsFailSafe) {
   PatternCalculator c = Make();
   const PositionEstimate ok{0, 0, 0, 0, true};
   Evaluation e = c.Evaluate(ok, 1'000'000);
   EXPECT_EQ(e.status, EvalStatus::kNoProfile);
-  EXPECT_EQ(e.speeds.v_e, 0);
-  EXPECT_EQ(e.speeds.v_s, 1);
+  EXPECT_EQ(e.speeds.v_e, kNoPermittedSpeed);
+  EXPECT_EQ(e.speeds.v_release, kNoPermittedSpeed);
+  EXPECT_EQ(e.speeds.v_s, 174);
   Supervisor sup;
   EXPECT_EQ(sup.Step(e.speeds, DriverInputs{true, false, false}).level, BrakeLevel::kEmergency);
   ASSERT_EQ(c.SetProfile({}, {}).verdict, ProfileVerdict::kAccept);
@@ -662,12 +683,13 @@ TEST(BrakingPatternsEvaluate, InvalidInputsFailSafe) {
                    kMaxPositionMm),
             EvalStatus::kOk);
   e = c.Evaluate({0, 0, 0, -5'000, false}, 1'000'000);
-  EXPECT_EQ(e.speeds.v_e, 0);
-  EXPECT_GE(e.speeds.v_s, 1);
-  // helpers: out-of-range arguments give 0
-  EXPECT_EQ(c.EmergencyPatternSpeed(0, kMaxPositionMm + 1), 0);
-  EXPECT_EQ(c.EmergencyPatternSpeed(0, 1'000'000, -1, 0), 0);
-  EXPECT_EQ(c.EmergencyPatternSpeed(kMaxPositionMm + kMaxPositionErrorMm + 1, kMaxPositionMm), 0);
+  EXPECT_EQ(e.speeds.v_e, kNoPermittedSpeed);
+  EXPECT_GT(e.speeds.v_s, e.speeds.v_e);
+  // helpers: out-of-range arguments permit nothing
+  EXPECT_EQ(c.EmergencyPatternSpeed(0, kMaxPositionMm + 1), kNoPermittedSpeed);
+  EXPECT_EQ(c.EmergencyPatternSpeed(0, 1'000'000, -1, 0), kNoPermittedSpeed);
+  EXPECT_EQ(c.EmergencyPatternSpeed(kMaxPositionMm + kMaxPositionErrorMm + 1, kMaxPositionMm),
+            kNoPermittedSpeed);
 }
 
 // ---- profile validation: one test per reason ------------------------------------------
@@ -854,7 +876,7 @@ TEST(BrakingPatternsProperty, NonIncreasingTowardsTheStopLimit) {
       prev_e = ve;
       prev_n = vn;
     }
-    EXPECT_EQ(prev_e, 0);
+    EXPECT_EQ(prev_e, kNoPermittedSpeed);
   }
 }
 

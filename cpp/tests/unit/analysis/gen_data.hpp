@@ -1,0 +1,34 @@
+// Generated inputs of the analysis unit tests: the line and train JSON that the build writes
+// from spec/ (build/gen/{lines,trains}; the build passes its directory as
+// RAILPROOF_TEST_GEN_DIR, and the environment variable RAILPROOF_GEN_DIR overrides it).
+#pragma once
+
+#include <cstdlib>
+#include <filesystem>
+#include <string>
+
+#include "railproof/analysis/train_type.hpp"
+
+namespace railproof::analysis::testdata {
+
+inline std::filesystem::path GenDir() {
+  if (const char* env = std::getenv("RAILPROOF_GEN_DIR")) {
+    return env;
+  }
+#if defined(RAILPROOF_TEST_GEN_DIR)
+  return RAILPROOF_TEST_GEN_DIR;
+#else
+  return std::filesystem::path(__FILE__).parent_path() / ".." / ".." / ".." / ".." / "build" / "gen";
+#endif
+}
+
+// A provided train type, or a negative-test type of spec/trains/mutants.
+inline TrainType Train(const std::string& name) {
+  const auto p = GenDir() / "trains" / (name + ".json");
+  if (std::filesystem::exists(p)) {
+    return LoadTrainType(p);
+  }
+  return LoadTrainType(GenDir() / "trains" / "mutants" / (name + ".json"));
+}
+
+}  // namespace railproof::analysis::testdata
