@@ -12,7 +12,7 @@ import sys
 from .errors import PipelineError, SpecError
 
 COMMAND_MODULES = ["params", "validate", "lines", "trace", "spin", "vectors", "evidence",
-                   "toolversions", "trains"]
+                   "toolversions", "trains", "proofs"]
 
 
 def build_parser():

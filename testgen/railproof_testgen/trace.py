@@ -658,8 +658,16 @@ class Tracer:
         return None
 
     # ----------------------------------------------------------------- proofs ----
+    # An obligation's expected verdict: a "; @expect sat|unsat" comment after its tag.
+    _PROOF_EXPECT = re.compile(r"^\s*;+\s*@expect\s+(\S+)\s*$")
+    _PROOF_SOLVERS = ("z3", "cvc5")
+
     def scan_proofs(self):
+        """Proof links from the tags in proofs/; then, if RESULTS_DIR/proofs/*.json exist
+        (written by ``railproof_testgen proofs``), every tagged obligation must have a
+        replay result in which both solvers returned its expected verdict."""
         root = self.src / "proofs"
+        self.proof_obligations = {}  # name -> {"file", "line", "expect", "requirements"}
         if not root.is_dir():
             return
         for f in sorted(p for p in root.rglob("*") if p.is_file()):
@@ -667,13 +675,18 @@ class Tracer:
             if lines is None:
                 continue
             rel = self.rel(f)
+            current = None
             for n, line in enumerate(lines, 1):
                 m = _PROOF_TAG.search(line)
                 if not m:
+                    em = self._PROOF_EXPECT.match(line)
+                    if em and current is not None and current["expect"] is None:
+                        current["expect"] = em.group(1)
                     continue
                 tag, body = m.group(1), m.group(2).strip()
                 entry = f"@{tag} (line {n})"
                 name = None
+                current = None
                 if tag == "obligation":
                     head = body.partition(" : ")[0].split(None, 1)
                     if head and not head[0].startswith("REQ-"):
@@ -687,6 +700,71 @@ class Tracer:
                 for r in ids:
                     self.add(r, "proof", {"file": rel, "obligation": name or f.stem})
                 self.obligation_set.add((rel, name or f.stem))
+                if name is not None:
+                    if name in self.proof_obligations:
+                        first = self.proof_obligations[name]
+                        if first["file"] != rel or first["line"] != n:
+                            self.error(f, entry, f"obligation already tagged in "
+                                                 f"{first['file']} (line {first['line']})", ids)
+                        continue
+                    current = {"file": rel, "line": n, "expect": None, "requirements": ids}
+                    self.proof_obligations[name] = current
+        self.scan_proof_results()
+
+    def scan_proof_results(self):
+        d = self.results / "proofs"
+        files = sorted(d.glob("*.json")) if d.is_dir() else []
+        if not files:
+            return  # proof links come from the tags alone until the proofs have been replayed
+        rows_by_name = {}
+        for f in files:
+            data = self.load_json(f)
+            if data is None:
+                continue
+            if not isinstance(data, dict) or not isinstance(data.get("obligations"), list):
+                self.error(f, "-", "expected an object with an 'obligations' list")
+                continue
+            ids = self.check_req_list(f, "requirements", data.get("requirements"))
+            if data.get("verdict") != "pass":
+                self.error(f, "verdict", f"proof replay failed ({data.get('verdict')!r})", ids)
+            for i, row in enumerate(data["obligations"]):
+                if not isinstance(row, dict) or not isinstance(row.get("obligation"), str):
+                    self.error(f, f"obligations[{i}]", "row needs an 'obligation' name")
+                    continue
+                rows_by_name.setdefault(row["obligation"], []).append((f, i, row))
+        for name, ob in sorted(self.proof_obligations.items()):
+            src_entry = f"@obligation {name} (line {ob['line']})"
+            rows = rows_by_name.get(name)
+            if not rows:
+                self.error(ob["file"], src_entry, f"no replay result in "
+                           f"{self.results.name}/proofs/*.json", ob["requirements"])
+                continue
+            exp = ob["expect"]
+            if exp not in ("sat", "unsat"):
+                self.error(ob["file"], src_entry, "no '@expect sat' or '@expect unsat' "
+                           "after the tag", ob["requirements"])
+                continue
+            for f, i, row in rows:
+                entry = str(row.get("name") or f"obligations[{i}]")
+                if row.get("source") not in (None, ob["file"]):
+                    self.error(f, entry, f"result is for {row.get('source')}, the obligation "
+                               f"is tagged in {ob['file']}", ob["requirements"])
+                if row.get("expected") != exp:
+                    self.error(f, entry, f"expected verdict {row.get('expected')!r} differs "
+                               f"from the source's @expect {exp}", ob["requirements"])
+                for solver in self._PROOF_SOLVERS:
+                    res = row.get(solver)
+                    got = res.get("verdict") if isinstance(res, dict) else None
+                    if got != exp:
+                        self.error(f, entry, f"{solver} verdict {got!r}, expected {exp}",
+                                   ob["requirements"])
+                if row.get("meets_target") is not True:
+                    self.error(f, entry, "target not met (meets_target is not true)",
+                               ob["requirements"])
+        for name in sorted(set(rows_by_name) - set(self.proof_obligations)):
+            for f, i, row in rows_by_name[name]:
+                self.error(f, str(row.get("name") or f"obligations[{i}]"),
+                           f"stale result: no @obligation {name} in proofs/")
 
     # --------------------------------------------------------------- analysis ----
     def scan_analysis(self):

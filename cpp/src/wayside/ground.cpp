@@ -420,6 +420,7 @@ void Ground::UpdateExtended(TrainState& t) noexcept {
 // @implements REQ-MB-002
 // @implements REQ-MB-003
 // @implements REQ-MB-019
+// @implements REQ-BR-016
 void Ground::SetPosition(TrainState& t, std::int64_t front_mm, std::int64_t correction_mm,
                          std::int64_t last_balise_mm, std::int64_t speed_mm_s) noexcept {
   t.front_mm = front_mm;
@@ -1151,6 +1152,7 @@ void Ground::FillRestrictions(StopLimitTelegram& telegram, const TrainState& t) 
 // @implements REQ-MB-004
 // @implements REQ-MB-006
 // @implements REQ-MB-007
+// @implements REQ-BR-015
 // @implements REQ-MB-008
 // @implements REQ-MB-014
 // @implements REQ-MB-016
