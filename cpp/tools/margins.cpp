@@ -618,7 +618,7 @@ int Main(int argc, char** argv) {
                                {"locations", job.rows.size()}, {"skipped", job.locs.skipped.size()}});
   }
   Json out{{"schema", "railproof/margins/1"},
-           {"requirements", {"REQ-BR-009", "REQ-BR-010", "REQ-BR-011", "REQ-BR-014", "REQ-BR-005", "REQ-BR-007", "REQ-SC-005"}},
+           {"requirements", {"REQ-BR-001", "REQ-BR-005", "REQ-BR-007", "REQ-BR-009", "REQ-BR-010", "REQ-BR-011", "REQ-BR-014", "REQ-SC-005"}},
            {"verdict", pass ? "pass" : "fail"},
            {"model",
             {{"speed_error", {{"n_1f", se.design.n_1f}, {"f_1_hz", se.design.f_1_hz}, {"envelope_c0_mm_s", se.c0_mm_s}, {"envelope_c1", se.c1}}},

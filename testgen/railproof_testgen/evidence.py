@@ -287,6 +287,8 @@ class Inputs:
     analysis: list = field(default_factory=list)      # [(rel, data)]
     scenario_plots: list = field(default_factory=list)  # [(name, Path of scenarios/<name>.svg)]
     scenario_logs: dict = field(default_factory=dict)   # name -> rel of scenarios/<name>.log.json
+    proofs: list = field(default_factory=list)          # [(rel, data)] of proofs/*.json
+    braking_plots: list = field(default_factory=list)   # [(name, Path of braking/<name>.svg)]
     justifications: dict = field(default_factory=dict)  # UR id -> entry (spec/justifications)
     model_sources: dict = field(default_factory=dict)   # model path -> text (None: not found)
     model_copies: dict = field(default_factory=dict)    # model path -> its copy under inputs/
@@ -559,6 +561,35 @@ def _load_scenarios(inp: Inputs) -> None:
         inp.files.append(InputFile(f, f"results/{rel}"))
 
 
+def _load_proofs(inp: Inputs) -> None:
+    """SMT proof results (proofs/<capability>.json, written by ``railproof_testgen
+    proofs``): obligations with the verdict of each solver."""
+    d = inp.results_dir / "proofs"
+    for f in sorted(d.glob("*.json")) if d.is_dir() else []:
+        data = _load_json(f, "proof result")
+        _require(isinstance(data, dict) and isinstance(data.get("obligations"), list), f,
+                 "obligations", "a proof result must hold a list 'obligations'")
+        rel = _rel(f, inp.results_dir)
+        inp.proofs.append((rel, data))
+        inp.files.append(InputFile(f, f"results/{rel}"))
+    for f in sorted(p for p in d.rglob("*.smt2") if p.is_file()) if d.is_dir() else []:
+        inp.files.append(InputFile(f, f"results/{_rel(f, inp.results_dir)}"))
+
+
+def _load_braking_plots(inp: Inputs) -> None:
+    """Plots of the braking analyses (braking/*.svg: margins per line and train type, the
+    speed-check design curve), embedded in the braking chapter."""
+    d = inp.results_dir / "braking"
+    for f in sorted(p for p in d.iterdir() if p.is_file()) if d.is_dir() else []:
+        rel = _rel(f, inp.results_dir)
+        if f.name.endswith(".svg"):
+            head = f.read_bytes()[:4096].lstrip()
+            _require(head.startswith(b"<?xml") or head.startswith(b"<svg"), f, "-",
+                     "not an SVG image")
+            inp.braking_plots.append((f.name[:-len(".svg")], f))
+        inp.files.append(InputFile(f, f"results/{rel}"))
+
+
 def _load_tool_versions(inp: Inputs, path: Path | None) -> None:
     if path is None:
         inp.missing.append("tool versions (--tool-versions)")
@@ -582,6 +613,8 @@ def load_inputs(spec_dir: Path, results_dir: Path, repo_root: Path,
     _load_tests(inp)
     _load_analysis(inp)
     _load_scenarios(inp)
+    _load_proofs(inp)
+    _load_braking_plots(inp)
     _load_tool_versions(inp, Path(tool_versions) if tool_versions else None)
     return inp
 
@@ -678,6 +711,7 @@ class Model:
         self._analysis()
         self._requirement_links()
         self._moving_block()
+        self._braking()
         self._versions()
         self._verdict()
 
@@ -1457,6 +1491,68 @@ class Model:
         mb["present"] = bool(mb["requirements"] or model or cov or vfs or scen or plots)
         self.mb = mb
 
+    # -- braking chapter ------------------------------------------------------------------
+    def _braking(self):
+        """The data of the braking chapter: REQ-BR and REQ-SC requirements, the braking
+        model's runs, mutants, goal coverage, vector files and conformance test file, the
+        speed-check design and margin analyses with their plots, and the SMT proofs (a
+        proof that does not come back with its expected verdict from both solvers fails
+        the package)."""
+        br = {"requirements": [r for r in self.requirements
+                               if r["id"].startswith(("REQ-BR-", "REQ-SC-"))]}
+        br["model"] = next((mo for mo in self.models if mo["stem"] == "braking"
+                            or mo["model"].endswith("braking.pml")), None)
+        br["coverage"] = next((c for c in self.coverage
+                               if Path(c["rel"]).name.startswith("braking")), None)
+        br["vector_files"] = [vf for vf in self.vector_files
+                              if Path(vf["rel"]).name.startswith("braking")]
+        br["conformance"] = [tf for tf in self.test_files if "conformance_br" in tf["rel"]]
+        by_stem = {a["stem"]: a for a in self.analyses}
+        br["speed_check"] = by_stem.get("speed_check_design")
+        br["margins"] = by_stem.get("margins")
+        # proofs
+        proofs = []
+        for rel, d in self.inp.proofs:
+            solvers = d.get("solvers") if isinstance(d.get("solvers"), dict) else {}
+            rows = []
+            for ob in d.get("obligations") or []:
+                if not isinstance(ob, dict):
+                    continue
+                res = {}
+                for solver in ("z3", "cvc5"):
+                    r = ob.get(solver) if isinstance(ob.get(solver), dict) else {}
+                    res[solver] = (str(r.get("verdict", "n/a")), fmt_value(r.get("time_s")))
+                expected = str(ob.get("expected", "n/a"))
+                ok = ob.get("meets_target") is not False and all(
+                    v == expected for v, _ in res.values())
+                if not ok:
+                    self.problems.append(f"proof {rel}: obligation {ob.get('name')} did not come "
+                                         f"back {expected} from both solvers")
+                reqs = [str(r) for r in ob.get("requirements") or []]
+                rows.append({"name": str(ob.get("name", "?")), "requirements": reqs,
+                             "links": [r for r in reqs if r in self.req_ids],
+                             "expected": expected, "z3": res["z3"], "cvc5": res["cvc5"],
+                             "ok": ok, "text": str(ob.get("text") or ob.get("title") or ""),
+                             "file": str(ob.get("smt2") or ""),
+                             "source": str(ob.get("source") or ""),
+                             "counterexample": {
+                                 solver: ", ".join(f"{k} = {v}" for k, v in sorted(
+                                     ob[solver]["model"].items()))
+                                 for solver in ("z3", "cvc5")
+                                 if isinstance(ob.get(solver), dict)
+                                 and isinstance(ob[solver].get("model"), dict)}})
+            if str(d.get("verdict", "pass")).lower() not in ("pass", "passed", "ok"):
+                self.problems.append(f"proof {rel}: verdict {d.get('verdict')!r}")
+            proofs.append({"rel": rel, "rows": rows, "verdict": str(d.get("verdict", "n/a")),
+                           "solvers": [(k, fmt_value(v.get("version") if isinstance(v, dict) else v))
+                                       for k, v in sorted(solvers.items())],
+                           "command": str(d.get("command") or "")})
+        br["proofs"] = proofs
+        br["plots"] = [{"name": n, "src": f"braking_plots/{n}.svg"} for n, _ in self.inp.braking_plots]
+        br["present"] = bool(br["requirements"] or br["model"] or proofs or br["margins"]
+                             or br["speed_check"])
+        self.br = br
+
     # -- tool versions --------------------------------------------------------------------
     def _versions(self):
         def flat(prefix, v, out):
@@ -1551,11 +1647,14 @@ def render_sources(model: Model, evidence_dir: Path, src_dir: Path) -> list:
                     ignore=shutil.ignore_patterns("templates", "__pycache__", "*.pyc", "_build",
                                                   "README.md"))
     env = _jinja_env(template_dir)
-    pages = ["overview", "traceability", "hazards", "model_checking", "moving_block",
+    pages = ["overview", "traceability", "hazards", "model_checking", "moving_block", "braking",
              "test_generation", "tests", "analysis", "tool_versions", "manifest"]
     for name, path in model.inp.scenario_plots:     # embedded by the moving-block chapter
         (src_dir / "scenario_plots").mkdir(parents=True, exist_ok=True)
         shutil.copyfile(path, src_dir / "scenario_plots" / f"{name}.svg")
+    for name, path in model.inp.braking_plots:      # embedded by the braking chapter
+        (src_dir / "braking_plots").mkdir(parents=True, exist_ok=True)
+        shutil.copyfile(path, src_dir / "braking_plots" / f"{name}.svg")
     ctx = {"m": model, "inp": model.inp}
     for page in pages:
         _write(src_dir / f"{page}.rst", env.get_template(f"{page}.rst.jinja").render(**ctx))
