@@ -21,6 +21,7 @@
 #include <nlohmann/json.hpp>
 
 #include "railproof/sim/line.hpp"
+#include "railproof/sim/output_file.hpp"
 #include "railproof/sim/scenario.hpp"
 #include "railproof/sim/simulation.hpp"
 
@@ -71,18 +72,7 @@ double ParseKmh(std::string_view opt, const std::string& text) {
 }
 
 void WriteFile(const std::filesystem::path& path, const std::string& text) {
-  const auto tmp = path.string() + ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::binary);
-    if (!out) {
-      throw InputError(path.string() + ": cannot write");
-    }
-    out << text;
-    if (!out) {
-      throw InputError(path.string() + ": write failed");
-    }
-  }
-  std::filesystem::rename(tmp, path);
+  railproof::sim::WriteFileAtomic(path, text);
 }
 
 void SetLeaderCap(railproof::sim::Scenario& sc, double kmh) {

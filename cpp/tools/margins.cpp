@@ -34,6 +34,7 @@
 #include "railproof/analysis/margins.hpp"
 #include "railproof/analysis/train_type.hpp"
 #include "railproof/sim/line.hpp"
+#include "railproof/sim/output_file.hpp"
 #include "railproof/sim/svg.hpp"
 
 namespace {
@@ -178,18 +179,7 @@ Options ParseArgs(int argc, char** argv) {
 }
 
 void WriteFile(const std::filesystem::path& path, const std::string& text) {
-  const auto tmp = path.string() + ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::binary);
-    if (!out) {
-      throw InputError(path.string() + ": cannot write");
-    }
-    out << text;
-    if (!out) {
-      throw InputError(path.string() + ": write failed");
-    }
-  }
-  std::filesystem::rename(tmp, path);
+  railproof::sim::WriteFileAtomic(path, text);
 }
 
 struct Row {

@@ -27,6 +27,7 @@
 #include "railproof/analysis/speedcheck_design.hpp"
 #include "railproof/sim/json_reader.hpp"
 #include "railproof/sim/line.hpp"
+#include "railproof/sim/output_file.hpp"
 
 namespace {
 
@@ -363,13 +364,10 @@ Json ComparisonJson(const an::SpeedCheckDesign& d, const std::string& what) {
 }
 
 void WriteFile(const std::string& path, const std::string& text) {
-  std::ofstream out(path, std::ios::binary);
-  if (!out) {
-    Fail("cannot write " + path);
-  }
-  out << text;
-  if (!out) {
-    Fail("cannot write " + path);
+  try {
+    railproof::sim::WriteFileAtomic(path, text);
+  } catch (const InputError& e) {
+    Fail(e.what());
   }
 }
 
