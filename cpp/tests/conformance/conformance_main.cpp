@@ -226,22 +226,6 @@ class VectorTest : public testing::Test {
   std::size_t index_;
 };
 
-class VectorSetTest : public testing::Test {
- public:
-  VectorSetTest(std::string error, std::size_t files, std::size_t vectors)
-      : error_(std::move(error)), files_(files), vectors_(vectors) {}
-  void TestBody() override {
-    RecordProperty("vector_files", static_cast<int>(files_));
-    RecordProperty("vectors", static_cast<int>(vectors_));
-    EXPECT_TRUE(error_.empty()) << error_;
-    EXPECT_GT(vectors_, 0U) << "a conformance run over no vectors is a failure";
-  }
-
- private:
-  std::string error_;
-  std::size_t files_;
-  std::size_t vectors_;
-};
 
 void Usage(std::FILE* out) {
   std::fprintf(out,
@@ -280,7 +264,7 @@ int main(int argc, char** argv) {
   const std::size_t vector_count = g_set.vectors.size();
   testing::RegisterTest("TelegramConformance", "VectorSet", nullptr, nullptr, __FILE__, __LINE__,
                         [error = loaded.error, files, vector_count]() -> testing::Test* {
-                          return new VectorSetTest(error, files, vector_count);
+                          return new rcli::VectorSetTest(error, files, vector_count);
                         });
   for (std::size_t i = 0; i < vector_count; ++i) {
     const rc::Vector& v = g_set.vectors[i];

@@ -334,21 +334,6 @@ class VectorTest : public testing::Test {
   std::size_t index_;
 };
 
-class VectorSetTest : public testing::Test {
- public:
-  VectorSetTest(std::string error, std::size_t files, std::size_t vectors)
-      : error_(std::move(error)), files_(files), vectors_(vectors) {}
-  void TestBody() override {
-    ASSERT_TRUE(error_.empty()) << error_;
-    EXPECT_GT(files_, 0U);
-    EXPECT_GT(vectors_, 0U);
-  }
-
- private:
-  std::string error_;
-  std::size_t files_;
-  std::size_t vectors_;
-};
 
 void Usage(std::FILE* f) {
   std::fprintf(f,
@@ -373,7 +358,7 @@ int main(int argc, char** argv) {
   }
   const std::size_t n = ok ? g_vectors.size() : 0;
   testing::RegisterTest("MovingBlockConformance", "VectorSet", nullptr, nullptr, __FILE__, __LINE__,
-                        [error, nfiles = files.size(), n]() -> testing::Test* { return new VectorSetTest(error, nfiles, n); });
+                        [error, nfiles = files.size(), n]() -> testing::Test* { return new rcli::VectorSetTest(error, nfiles, n); });
   for (std::size_t i = 0; i < n; ++i) {
     const Vector& v = g_vectors[i];
     testing::RegisterTest("MovingBlockConformance", v.test_name.c_str(), nullptr, nullptr,

@@ -14,6 +14,7 @@
 #include <cstdio>
 #include <cstring>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace railproof::conformance {
@@ -21,6 +22,26 @@ namespace railproof::conformance {
 struct RunnerArgs {
   std::string vectors_dir;
   int exit_code = -1;  // >= 0: main returns it at once (--help, bad arguments)
+};
+
+// The first test of every run: the vector set loaded without error and is not empty (a
+// conformance run over no vectors is a failure). Records the counts for the evidence.
+class VectorSetTest : public testing::Test {
+ public:
+  VectorSetTest(std::string error, std::size_t files, std::size_t vectors)
+      : error_(std::move(error)), files_(files), vectors_(vectors) {}
+  void TestBody() override {
+    RecordProperty("vector_files", static_cast<int>(files_));
+    RecordProperty("vectors", static_cast<int>(vectors_));
+    ASSERT_TRUE(error_.empty()) << error_;
+    EXPECT_GT(files_, 0U);
+    EXPECT_GT(vectors_, 0U) << "a conformance run over no vectors is a failure";
+  }
+
+ private:
+  std::string error_;
+  std::size_t files_;
+  std::size_t vectors_;
 };
 
 // Reads the runner's own flags, passes --gtest_* flags (and --junit as --gtest_output) to
