@@ -24,8 +24,9 @@ from pathlib import Path
 from . import __version__
 from . import spin as spin_mod
 from .errors import PipelineError, SpecError
-from .vectors import (_atomic_write, load_justifications, schema_checked_jsonl, search_goal,
-                      write_goals_file)
+from .vectors import _atomic_write, _progress, load_justifications, schema_checked_jsonl, search_goal, \
+    write_goals_file
+from .vectors import model_bounds as _bounds
 
 # braking::BrakeLevel in order, named as braking::ToString
 LEVELS = ["NONE", "4N", "5N", "6N", "7N", "EB"]
@@ -98,15 +99,6 @@ def header_for(model: Path, b: dict):
         "units": UNITS, "unit_scales": {"speed_mm_s_per_unit": 1},
         "parameters": {"model_vmax": b["vmax"], "model_cycles": b["cycles"], "levels": LEVELS},
     }
-
-
-def _bounds(params_pml: Path):
-    raw = spin_mod.read_bounds(params_pml)
-    return {k[len("model_"):] if k.startswith("model_") else k: v for k, v in raw.items()}
-
-
-def _progress(msg):
-    print(f"vectors: {msg}", flush=True)
 
 
 def generate(model: Path, params_dir: Path, spec_dir: Path, workdir: Path, out_dir: Path,

@@ -18,8 +18,9 @@ from pathlib import Path
 from . import __version__
 from . import spin as spin_mod
 from .errors import PipelineError, SpecError
-from .vectors import (_atomic_write, load_justifications, schema_checked_jsonl, search_goal,
-                      write_goals_file)
+from .vectors import _atomic_write, _progress, load_justifications, schema_checked_jsonl, search_goal, \
+    write_goals_file
+from .vectors import model_bounds as _bounds
 
 NOTEL = -9
 KINDS = ["NONE", "PRECEDING_TRAIN", "FIXED_BLOCK", "ROUTE_END", "HANDOVER", "SYSTEM_BOUNDARY",
@@ -205,15 +206,6 @@ def header_for(model: Path, b: dict, config):
 def _ext(b, p):
     e = (p % b["balise_spacing_units"]) // b["odo_units_per_ext"]
     return min(e, b["ext_max"])
-
-
-def _bounds(params_pml: Path):
-    raw = spin_mod.read_bounds(params_pml)
-    return {k[len("model_"):] if k.startswith("model_") else k: v for k, v in raw.items()}
-
-
-def _progress(msg):
-    print(f"vectors: {msg}", flush=True)
 
 
 def generate(model: Path, params_dir: Path, spec_dir: Path, workdir: Path, out_dir: Path,

@@ -177,6 +177,13 @@ def _progress(msg):
     print(f"vectors: {msg}", flush=True)
 
 
+def model_bounds(params_pml: Path):
+    """The model bounds of a generated <model>_params.pml, keyed without their "model_"
+    prefix (shared by the moving-block and braking generators)."""
+    raw = spin_mod.read_bounds(params_pml)
+    return {k[len("model_"):] if k.startswith("model_") else k: v for k, v in raw.items()}
+
+
 def generate(model: Path, params_dir: Path, spec_dir: Path, workdir: Path, out_dir: Path,
              walks: int = 50, walk_steps: int = 7000, jobs: int = 2):
     model = Path(model)
