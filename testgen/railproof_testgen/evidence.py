@@ -289,6 +289,7 @@ class Inputs:
     scenario_logs: dict = field(default_factory=dict)   # name -> rel of scenarios/<name>.log.json
     proofs: list = field(default_factory=list)          # [(rel, data)] of proofs/*.json
     braking_plots: list = field(default_factory=list)   # [(name, Path of braking/<name>.svg)]
+    odometry_plots: list = field(default_factory=list)  # [(name, Path of odometry/<name>.svg)]
     justifications: dict = field(default_factory=dict)  # UR id -> entry (spec/justifications)
     model_sources: dict = field(default_factory=dict)   # model path -> text (None: not found)
     model_copies: dict = field(default_factory=dict)    # model path -> its copy under inputs/
@@ -576,17 +577,19 @@ def _load_proofs(inp: Inputs) -> None:
         inp.files.append(InputFile(f, f"results/{_rel(f, inp.results_dir)}"))
 
 
-def _load_braking_plots(inp: Inputs) -> None:
-    """Plots of the braking analyses (braking/*.svg: margins per line and train type, the
-    speed-check design curve), embedded in the braking chapter."""
-    d = inp.results_dir / "braking"
+def _load_chapter_plots(inp: Inputs, subdir: str, plots: list) -> None:
+    """Plots of a chapter's analyses (results/<subdir>/*.svg; braking: margins per line and
+    train type and the speed-check design curve; odometry: the wheel-rail scenarios, error
+    envelopes and margin comparisons), embedded in that chapter. Every other file of the
+    directory (per-location or per-event JSON) is an input of the package too."""
+    d = inp.results_dir / subdir
     for f in sorted(p for p in d.iterdir() if p.is_file()) if d.is_dir() else []:
         rel = _rel(f, inp.results_dir)
         if f.name.endswith(".svg"):
             head = f.read_bytes()[:4096].lstrip()
             _require(head.startswith(b"<?xml") or head.startswith(b"<svg"), f, "-",
                      "not an SVG image")
-            inp.braking_plots.append((f.name[:-len(".svg")], f))
+            plots.append((f.name[:-len(".svg")], f))
         inp.files.append(InputFile(f, f"results/{rel}"))
 
 
@@ -614,7 +617,8 @@ def load_inputs(spec_dir: Path, results_dir: Path, repo_root: Path,
     _load_analysis(inp)
     _load_scenarios(inp)
     _load_proofs(inp)
-    _load_braking_plots(inp)
+    _load_chapter_plots(inp, "braking", inp.braking_plots)
+    _load_chapter_plots(inp, "odometry", inp.odometry_plots)
     _load_tool_versions(inp, Path(tool_versions) if tool_versions else None)
     return inp
 
@@ -712,6 +716,7 @@ class Model:
         self._requirement_links()
         self._moving_block()
         self._braking()
+        self._readhesion()
         self._versions()
         self._verdict()
 
@@ -1491,6 +1496,32 @@ class Model:
         mb["present"] = bool(mb["requirements"] or model or cov or vfs or scen or plots)
         self.mb = mb
 
+    def _capability(self, prefixes: tuple, stem: str, conformance: str) -> dict:
+        """A capability chapter's common data: its requirements (by ID prefix), the model
+        models/<stem>.pml with its runs and mutants, its goal coverage and vector files
+        (<stem>*), and its conformance test file (results/tests/<conformance>.xml)."""
+        return {"requirements": [r for r in self.requirements if r["id"].startswith(prefixes)],
+                "model": next((mo for mo in self.models if mo["stem"] == stem
+                               or mo["model"].endswith(f"{stem}.pml")), None),
+                "coverage": next((c for c in self.coverage
+                                  if Path(c["rel"]).name.startswith(stem)), None),
+                "vector_files": [vf for vf in self.vector_files
+                                 if Path(vf["rel"]).name.startswith(stem)],
+                "conformance": [tf for tf in self.test_files if conformance in tf["rel"]]}
+
+    # -- re-adhesion chapter --------------------------------------------------------------
+    def _readhesion(self):
+        """The data of the re-adhesion chapter: REQ-RA requirements, the readhesion model's
+        runs, mutants, goal coverage, vectors and conformance, the odometry study on the
+        Box2D wheel-rail scenarios (error bound per event, baseline comparison, margin and
+        clearing-time tables) and its plots."""
+        ra = self._capability(("REQ-RA-",), "readhesion", "conformance_ra")
+        ra["study"] = next((a for a in self.analyses if a["stem"] == "odometry_study"), None)
+        ra["plots"] = [{"name": n, "src": f"odometry_plots/{n}.svg"}
+                       for n, _ in self.inp.odometry_plots]
+        ra["present"] = bool(ra["requirements"] or ra["model"] or ra["study"])
+        self.ra = ra
+
     # -- braking chapter ------------------------------------------------------------------
     def _braking(self):
         """The data of the braking chapter: REQ-BR and REQ-SC requirements, the braking
@@ -1498,15 +1529,7 @@ class Model:
         speed-check design and margin analyses with their plots, and the SMT proofs (a
         proof that does not come back with its expected verdict from both solvers fails
         the package)."""
-        br = {"requirements": [r for r in self.requirements
-                               if r["id"].startswith(("REQ-BR-", "REQ-SC-"))]}
-        br["model"] = next((mo for mo in self.models if mo["stem"] == "braking"
-                            or mo["model"].endswith("braking.pml")), None)
-        br["coverage"] = next((c for c in self.coverage
-                               if Path(c["rel"]).name.startswith("braking")), None)
-        br["vector_files"] = [vf for vf in self.vector_files
-                              if Path(vf["rel"]).name.startswith("braking")]
-        br["conformance"] = [tf for tf in self.test_files if "conformance_br" in tf["rel"]]
+        br = self._capability(("REQ-BR-", "REQ-SC-"), "braking", "conformance_br")
         by_stem = {a["stem"]: a for a in self.analyses}
         br["speed_check"] = by_stem.get("speed_check_design")
         br["margins"] = by_stem.get("margins")
@@ -1648,13 +1671,15 @@ def render_sources(model: Model, evidence_dir: Path, src_dir: Path) -> list:
                                                   "README.md"))
     env = _jinja_env(template_dir)
     pages = ["overview", "traceability", "hazards", "model_checking", "moving_block", "braking",
-             "test_generation", "tests", "analysis", "tool_versions", "manifest"]
+             "readhesion", "test_generation", "tests", "analysis", "tool_versions", "manifest"]
     for name, path in model.inp.scenario_plots:     # embedded by the moving-block chapter
         (src_dir / "scenario_plots").mkdir(parents=True, exist_ok=True)
         shutil.copyfile(path, src_dir / "scenario_plots" / f"{name}.svg")
-    for name, path in model.inp.braking_plots:      # embedded by the braking chapter
-        (src_dir / "braking_plots").mkdir(parents=True, exist_ok=True)
-        shutil.copyfile(path, src_dir / "braking_plots" / f"{name}.svg")
+    for sub, plots in (("braking_plots", model.inp.braking_plots),     # braking chapter
+                       ("odometry_plots", model.inp.odometry_plots)):  # re-adhesion chapter
+        for name, path in plots:
+            (src_dir / sub).mkdir(parents=True, exist_ok=True)
+            shutil.copyfile(path, src_dir / sub / f"{name}.svg")
     ctx = {"m": model, "inp": model.inp}
     for page in pages:
         _write(src_dir / f"{page}.rst", env.get_template(f"{page}.rst.jinja").render(**ctx))
