@@ -7,7 +7,7 @@
 #   evidence  : test results as JUnit XML (unit, conformance, testgen), residual-error
 #               analysis, tool versions, trace.json, and the rendered evidence package
 #               in ${CMAKE_BINARY_DIR}/evidence (HTML + manifest.json with SHA-256).
-set(RAILPROOF_MODELS telegram moving_block braking)
+set(RAILPROOF_MODELS telegram moving_block braking readhesion)
 set(RAILPROOF_VECTOR_DIR ${RAILPROOF_RESULTS_DIR}/vectors)
 set(_spin_outputs)
 set(_vector_outputs)

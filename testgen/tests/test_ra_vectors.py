@@ -1,0 +1,287 @@
+"""Tests of the re-adhesion state machine vectors (railproof_testgen.ra_vectors,
+models/readhesion.pml, spec/schemas/vectors_readhesion.schema.json). The C++ conformance
+runner (railproof_conformance_ra) is the behavioural check of the vectors; these tests check
+that they are parsed, converted, schema-checked, generated for both machine configurations,
+consistent with design note §5 and cover every goal (or justify it)."""
+import copy
+import json
+import shutil
+from pathlib import Path
+
+import jsonschema
+import pytest
+import yaml
+
+from railproof_testgen import ra_vectors, spin, vectors
+from railproof_testgen.errors import PipelineError
+
+REPO = Path(__file__).resolve().parents[2]
+MODEL = REPO / "models" / "readhesion.pml"
+SCHEMA = REPO / "spec" / "schemas" / "vectors_readhesion.schema.json"
+needs_spin = pytest.mark.skipif(shutil.which("spin") is None or shutil.which("cc") is None,
+                                reason="spin and a C compiler are needed")
+
+# the seeded C++ faults of cpp/src/odometry/readhesion_machine.cpp, each mirrored by a mutant
+CPP_FAULTS = ["TIMEOUT_OFF_BY_ONE", "CONFIRM_TWO", "SPEED_IGNORED", "EPISODE_RELAXES", "LAST_CANDIDATE_WINS",
+              "TG_FAILURE_IGNORED"]
+BOUNDS = {"confirm": 3, "start_age": 2, "search_extra": 1, "spacing": 2, "tmax_long": 9, "tmax_short": 6,
+          "margin_long": 2, "margin_steep": 3, "margin_short": 1, "cycles": 16}
+
+
+def test_annotations_of_the_readhesion_model():
+    ann = spin.parse_annotations(MODEL)
+    props = {p.name: p for p in ann.properties}
+    assert set(props) == {"REQ_RA_003_detection", "REQ_RA_004_start_point", "REQ_RA_006_readhesion", "REQ_RA_007_timeout",
+                          "REQ_RA_007_stopped", "REQ_RA_009_limits", "REQ_RA_010_parallel", "REQ_RA_012_balise",
+                          "REQ_RA_013_sensor"}
+    for name, p in props.items():  # named by the requirement it verifies, default configuration
+        assert name[:10].replace("_", "-") in p.requirements
+        assert p.config is None
+    covered = {r for p in ann.properties for r in p.requirements}
+    assert covered == {"REQ-RA-003", "REQ-RA-004", "REQ-RA-006", "REQ-RA-007", "REQ-RA-009", "REQ-RA-010", "REQ-RA-012",
+                       "REQ-RA-013"}
+    # the one-start-point configuration: a variant, so every property is verified in it too
+    assert [(v.define, v.parameter, v.bound) for v in ann.variants] == [("ONE_START", "start_points", "1")]
+    assert set(ra_vectors.CONFIGS) == {None, "ONE_START"}
+    mutants = {m.name: m for m in ann.mutants}
+    assert {f"MUTANT_{f}" for f in CPP_FAULTS} <= set(mutants)
+    assert len(mutants) > len(CPP_FAULTS)
+    for f in CPP_FAULTS:  # each mutant names the C++ fault it mirrors
+        assert f"FAULT_RA_{f}" in mutants[f"MUTANT_{f}"].text
+    assert all(m.violates in props and m.config is None for m in ann.mutants)
+    assert [g.number for g in ann.goals] == list(range(len(ann.goals)))
+    assert all(g.requirements and g.label for g in ann.goals)
+    assert {g.config for g in ann.goals} == {None, "ONE_START"}
+
+
+def _cycle(dev=0, sa=(0, 0), imu=1, tg=1, bal=0, sec=0, age=2, **out):
+    o = {"mode": 0, "reason": 0, "dcount": 0, "a0": 0, "t0": 0, "c0": 0, "a1": 0, "t1": 0, "c1": 0, "tmax": 9,
+         "margin": 2, "stop": 0, "valid": 1, "det": 0, "adopted": 255, "breset": 0}
+    o.update(out)
+    return [f"  @IN cycle dev={dev} sa0={sa[0]} sa1={sa[1]} imu={imu} tg={tg} bal={bal} sec={sec} age={age}",
+            "  @OUT " + " ".join(f"{k}={v}" for k, v in o.items())]
+
+
+def test_parse_events_and_steps():
+    text = "\n".join(
+        ["spin: some unrelated line"]
+        + _cycle(dev=1, sec=1, age=3, mode=1, a0=1, t0=3, a1=1, t1=5, margin=3, det=1, breset=0)
+        + _cycle(sa=(1, 0), sec=2, mode=0, tmax=6, margin=3, adopted=0)
+        + _cycle(imu=0, tg=0, bal=1, mode=2, reason=2, tmax=9, stop=1, valid=0)
+        + ["  @IN cycle dev=0 sa0=0 sa1=0 imu=1 tg=1 bal=0 sec=0 age=2"])  # cut off by the end of a trail
+    ev = ra_vectors.parse_events(text)
+    assert len(ev) == 3
+    assert ev[0][0] == {"dev": True, "sa": [False, False], "imu": True, "tg": True, "bal": False, "sec": 1,
+                        "age": 3}
+    steps = ra_vectors.to_steps(ev, BOUNDS)
+    assert steps[0] == {
+        "in": {"deviation": True, "speed_agrees": [False, False], "imu_ok": True, "tg_ok": True, "balise": False,
+               "section": {"kind": "STEEP", "max_compensation_cycles": 9, "margin_mm": 3},
+               "start_age_cycles": 3},
+        "out": {"mode": "COMPENSATING", "stop_reason": "NONE", "deviation_count": 0,
+                "candidates": [{"active": True, "age_cycles": 3, "confirm": 0},
+                               {"active": True, "age_cycles": 5, "confirm": 0}],
+                "max_compensation_cycles": 9, "margin_mm": 3, "stop_demand": False, "position_valid": True,
+                "detected": True, "adopted": None, "balise_reset": False}}
+    assert steps[1]["in"]["section"] == {"kind": "TIGHT", "max_compensation_cycles": 6, "margin_mm": 1}
+    assert steps[1]["in"]["speed_agrees"] == [True, False]
+    assert steps[1]["out"]["adopted"] == 0 and steps[1]["out"]["mode"] == "TG"
+    assert steps[2]["out"]["stop_reason"] == "IMU_FAILURE" and steps[2]["out"]["stop_demand"]
+    assert not steps[2]["in"]["imu_ok"] and steps[2]["in"]["balise"]
+    assert ra_vectors.observed_requirements(steps) == {"REQ-RA-003", "REQ-RA-004", "REQ-RA-006", "REQ-RA-009", "REQ-RA-010",
+                                                        "REQ-RA-013"}
+    assert ra_vectors.observed_requirements([]) == set()
+
+
+def test_malformed_model_output_is_an_error():
+    with pytest.raises(PipelineError, match="without its @IN cycle"):
+        ra_vectors.parse_events(_cycle()[1])
+    with pytest.raises(PipelineError, match="unrecognised"):
+        ra_vectors.parse_events("@OUT level=1 appr=0 latched=0")
+    with pytest.raises(PipelineError, match="unknown adopted"):
+        ra_vectors.to_steps(ra_vectors.parse_events("\n".join(_cycle(adopted=7))), BOUNDS)
+    with pytest.raises(PipelineError, match="outside the known"):
+        ra_vectors.to_steps(ra_vectors.parse_events("\n".join(_cycle(sec=3))), BOUNDS)
+
+
+def _header(config=None):
+    h = ra_vectors.header_for(MODEL, BOUNDS, config)
+    h["spin_version"] = "test"
+    return h
+
+
+def _vector():
+    steps = ra_vectors.to_steps(ra_vectors.parse_events("\n".join(
+        _cycle(dev=1, mode=1, a0=1, t0=2, a1=1, t1=4, det=1))), BOUNDS)
+    return {"id": "RA-TRAP-G0", "requirements": ["REQ-RA-003"], "goal": "G0", "kind": "trap", "seed": None,
+            "steps": steps}
+
+
+def test_header_records_the_machine_configuration():
+    h, h1 = _header(), _header("ONE_START")
+    assert h["configuration"] == "default" and h1["configuration"] == "ONE_START"
+    assert h["parameters"]["start_points"] == 2 and h1["parameters"]["start_points"] == 1
+    assert h["parameters"]["confirm_cycles"] == 3 and h["parameters"]["spacing_cycles"] == 2
+    assert h["parameters"]["start_age_cycles"] == [2, 3]
+    assert h["units"] == ra_vectors.UNITS == "model ticks = cycles, model margin units = mm"
+    assert [s["kind"] for s in h["parameters"]["sections"]] == ra_vectors.SECTIONS
+
+
+def test_schema_accepts_good_and_rejects_bad_records(tmp_path):
+    good = [_header(), _vector()]
+    text = vectors.schema_checked_jsonl(SCHEMA, good, "readhesion.jsonl")
+    assert [json.loads(ln) for ln in text.splitlines()] == good
+    vectors.schema_checked_jsonl(SCHEMA, [_header("ONE_START"), {**_vector(), "id": "RA-TRAP-ONESTART-G0"}],
+                                 "readhesion.one_start.jsonl")
+
+    def broken(edit):
+        lines = copy.deepcopy(good)
+        edit(lines)
+        return lines
+
+    cases = {
+        "units": lambda ls: ls[0].update(units="cycles"),
+        "configuration and start points disagree": lambda ls: ls[0]["parameters"].update(start_points=1),
+        "unknown configuration": lambda ls: ls[0].update(configuration="THREE_START"),
+        "machine parameter missing": lambda ls: ls[0]["parameters"].pop("spacing_cycles"),
+        "bad vector id": lambda ls: ls[1].update(id="BR-TRAP-G0"),
+        "no requirement": lambda ls: ls[1].update(requirements=[]),
+        "unknown mode": lambda ls: ls[1]["steps"][0]["out"].update(mode="SLIPPING"),
+        "adopted out of range": lambda ls: ls[1]["steps"][0]["out"].update(adopted=2),
+        "output field missing": lambda ls: ls[1]["steps"][0]["out"].pop("balise_reset"),
+        "extra input field": lambda ls: ls[1]["steps"][0]["in"].update(speed=3),
+        "one speed agreement only": lambda ls: ls[1]["steps"][0]["in"].update(speed_agrees=[True]),
+        "section time zero": lambda ls: ls[1]["steps"][0]["in"]["section"].update(max_compensation_cycles=0),
+        "three candidates": lambda ls: ls[1]["steps"][0]["out"]["candidates"].append(
+            {"active": False, "age_cycles": 0, "confirm": 0}),
+        "no steps": lambda ls: ls[1].update(steps=[]),
+    }
+    for what, edit in cases.items():
+        with pytest.raises(PipelineError, match="violates the vector schema"):
+            vectors.schema_checked_jsonl(SCHEMA, broken(edit), "readhesion.jsonl")
+            pytest.fail(f"schema accepted: {what}")
+
+
+@pytest.fixture(scope="module")
+def generated(tmp_path_factory):
+    if shutil.which("spin") is None or shutil.which("cc") is None:
+        pytest.skip("spin and a C compiler are needed")
+    tmp = tmp_path_factory.mktemp("ra")
+    params = tmp / "params"
+    params.mkdir()
+    # the model bounds of spec/parameters/readhesion.yaml, as gen-params writes them
+    data = yaml.safe_load((REPO / "spec" / "parameters" / "readhesion.yaml").read_text(encoding="utf-8"))
+    (params / "readhesion_params.pml").write_text(
+        "".join(f"#define {e['id'].upper()} {e['value']}\n" for e in data["model_bounds"]), encoding="utf-8")
+    out = tmp / "vectors"
+    out.mkdir()
+    (out / "readhesion.stale.jsonl").write_text("{}\n", encoding="utf-8")  # an earlier run's file
+    cov = vectors.generate(MODEL, params, REPO / "spec", tmp / "work", out, walks=5, jobs=2)
+    files = {}
+    for name in ("readhesion.jsonl", "readhesion.one_start.jsonl"):
+        files[name] = [json.loads(ln) for ln in (out / name).read_text(encoding="utf-8").splitlines()]
+    return cov, files, out, spin.read_bounds(params / "readhesion_params.pml")
+
+
+@needs_spin
+def test_vectors_are_schema_valid_and_cover_every_goal(generated):
+    cov, files, out, _bounds = generated
+    assert sorted(p.name for p in out.glob("*.jsonl")) == ["readhesion.jsonl", "readhesion.one_start.jsonl"]
+    validator = jsonschema.Draft202012Validator(json.loads(SCHEMA.read_text(encoding="utf-8")))
+    ids = set()
+    for name, lines in files.items():
+        for n, obj in enumerate(lines, 1):
+            assert not list(validator.iter_errors(obj)), f"{name} line {n}"
+        header = lines[0]
+        assert header["model"] == "models/readhesion.pml" and header["model_sha256"] == spin.sha256_file(MODEL)
+        one = name == "readhesion.one_start.jsonl"
+        assert header["configuration"] == ("ONE_START" if one else "default")
+        assert header["parameters"]["start_points"] == (1 if one else 2)
+        for v in lines[1:]:
+            assert v["id"] not in ids
+            ids.add(v["id"])
+            assert ("ONESTART-" in v["id"]) == one
+    ann = spin.parse_annotations(MODEL)
+    assert cov["labelled"] == len(ann.goals)
+    justifications = yaml.safe_load((REPO / "spec" / "justifications" / "readhesion.yaml").read_text())
+    justified = {j["goal"]: j["id"] for j in justifications["justifications"]}
+    for g in cov["goals"]:  # reached with a vector, or justified
+        if g["status"] == "reached":
+            assert g["vectors"] and set(g["vectors"]) <= ids
+        else:
+            assert g["justification"] == justified[g["id"]], g
+        assert set(g.get("variant_vectors", [])) <= ids
+    assert cov["reached"] + cov["unreachable_justified"] == len(ann.goals)
+    one_start = [g for g in cov["goals"] if g["configuration"] == "ONE_START"]
+    assert one_start and all(g["status"] == "reached" for g in one_start)
+    assert sum(v["kind"] == "random" for v in files["readhesion.jsonl"][1:]) == 5
+    assert sum(v["kind"] == "random" for v in files["readhesion.one_start.jsonl"][1:]) == 1
+    assert cov["files"] == {n: len(lines) - 1 for n, lines in files.items()}
+    on_disk = json.loads((out / "readhesion.coverage.json").read_text(encoding="utf-8"))
+    assert on_disk["reached"] == cov["reached"]
+
+
+@needs_spin
+def test_vectors_follow_the_design_note(generated):
+    """Invariants of design note §5 on every step of every vector (the exact values are the
+    C++ conformance runner's check)."""
+    _cov, files, _out, b = generated
+    for name, lines in files.items():
+        points = lines[0]["parameters"]["start_points"]
+        for v in lines[1:]:
+            prev = "TG"
+            for s in v["steps"]:
+                i, o = s["in"], s["out"]
+                stopped = o["mode"] == "STOPPED"
+                assert o["stop_demand"] == stopped and o["position_valid"] == (not stopped), v["id"]
+                assert (o["stop_reason"] != "NONE") == stopped
+                if not (i["imu_ok"] and i["tg_ok"]):  # REQ-RA-013: the safe reaction in the same cycle
+                    assert o["stop_reason"] == ("IMU_FAILURE" if not i["imu_ok"] else "TG_FAILURE")
+                    assert not any(c["active"] for c in o["candidates"])
+                if points == 1:
+                    assert not o["candidates"][1]["active"]
+                for c in o["candidates"]:  # REQ-RA-007: never beyond t_max
+                    assert not c["active"] or c["age_cycles"] <= o["max_compensation_cycles"]
+                    assert c["active"] or (c["age_cycles"], c["confirm"]) == (0, 0)
+                if o["adopted"] is not None:  # REQ-RA-010: nothing active after the adoption
+                    assert o["mode"] == "TG" and not any(c["active"] for c in o["candidates"])
+                if prev != "COMPENSATING":  # REQ-RA-009: outside an episode the section's limits
+                    assert o["margin_mm"] == i["section"]["margin_mm"]
+                    assert o["max_compensation_cycles"] == i["section"]["max_compensation_cycles"]
+                else:
+                    assert o["margin_mm"] >= i["section"]["margin_mm"]
+                    assert o["max_compensation_cycles"] <= i["section"]["max_compensation_cycles"]
+                if o["balise_reset"]:  # REQ-RA-012
+                    assert i["balise"] and prev != "COMPENSATING"
+                if o["detected"]:
+                    assert o["candidates"][0]["age_cycles"] == i["start_age_cycles"]
+                    if points == 2:
+                        assert o["candidates"][1]["age_cycles"] == i["start_age_cycles"] + b["spacing"]
+                prev = o["mode"]
+
+
+@needs_spin
+def test_boundary_vectors_hit_the_boundaries(generated):
+    _cov, files, _out, b = generated
+    vecs = {v["goal"]: v for v in files["readhesion.jsonl"][1:] if v["goal"]}
+    last = {g: v["steps"][-1] for g, v in vecs.items()}
+    # G12: compensating at exactly t_max; G13: the last candidate discarded at t_max + 1
+    o = last["G12"]["out"]
+    assert o["mode"] == "COMPENSATING" and o["candidates"][0]["age_cycles"] == o["max_compensation_cycles"]
+    before, o = vecs["G13"]["steps"][-2]["out"], last["G13"]["out"]
+    assert o["stop_reason"] == "MAX_COMPENSATION_TIME" and o["stop_demand"] and not o["position_valid"]
+    assert before["candidates"][0]["age_cycles"] == o["max_compensation_cycles"]  # one more cycle: t_max + 1
+    # G4: adoption exactly MODEL_CONFIRM cycles after the detection; G10: both confirm, primary wins
+    det = next(k for k, s in enumerate(vecs["G4"]["steps"]) if s["out"]["detected"])
+    assert len(vecs["G4"]["steps"]) - 1 - det == b["confirm"] and last["G4"]["out"]["adopted"] == 0
+    assert last["G10"]["in"]["speed_agrees"] == [True, True] and last["G10"]["out"]["adopted"] == 0
+    assert last["G8"]["out"]["adopted"] == 1
+    # G6: the speed condition alone restarts the confirmation
+    s = last["G6"]
+    assert not s["in"]["deviation"] and not s["in"]["speed_agrees"][0]
+    assert s["out"]["candidates"][0]["confirm"] == 0
+    # G18: the episode keeps a margin above the current section's
+    s = last["G18"]
+    assert s["out"]["mode"] == "COMPENSATING" and s["out"]["margin_mm"] > s["in"]["section"]["margin_mm"]
+    # G24: a TG failure in TG odometry stops the train
+    assert last["G24"]["out"]["stop_reason"] == "TG_FAILURE" and not last["G24"]["in"]["tg_ok"]
