@@ -172,8 +172,8 @@ if(TARGET odometry_study)
     COMMAND ${CMAKE_COMMAND} -E make_directory ${RAILPROOF_RESULTS_DIR}/analysis ${RAILPROOF_RESULTS_DIR}/odometry
     COMMAND odometry_study --scenarios ${RAILPROOF_SOURCE_DIR}/spec/wheelrail
             --out-dir ${RAILPROOF_RESULTS_DIR}/odometry --json ${_study}
-            --trains-dir ${RAILPROOF_GEN_DIR}/trains
-    DEPENDS odometry_study ${_wheelrail_scenarios} ${RAILPROOF_TRAIN_JSON}
+            --trains-dir ${RAILPROOF_GEN_DIR}/trains --lines-dir ${RAILPROOF_GEN_DIR}/lines --quiet
+    DEPENDS odometry_study ${_wheelrail_scenarios} ${RAILPROOF_TRAIN_JSON} ${RAILPROOF_LINE_JSON}
     COMMENT "analysis: odometry on the wheel-rail scenarios (error bound, envelope, baseline)"
     USES_TERMINAL VERBATIM)
   list(APPEND _odometry_outputs ${_study})
