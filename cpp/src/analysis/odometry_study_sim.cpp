@@ -289,6 +289,33 @@ void CheckSafeReaction(ScenarioStudy& st) {
   st.checks.push_back(chk);
 }
 
+// A scenario without injected sensor faults must not raise a detection that no simulated
+// slip/slide caused (with two start points, the configured method). A spurious detection
+// is not unsafe in itself (the envelope check covers that) but each one compensates from
+// the IMU and moves the position; the check guards against the odometry's own signal
+// processing creating deviations (e.g. a TG-history step coming back through A_p).
+void CheckNoSpuriousDetection(ScenarioStudy& st) {
+  if (!st.scenario.faults.empty()) {
+    return;  // injected faults (a stuck TG) are detected as slides by design
+  }
+  const StudyRun& r = st.primary;
+  ScenarioCheck chk{"no_spurious_detection", true, ""};
+  int spurious = 0;
+  std::string first;
+  for (std::size_t i = 0; i < r.episode_event.size(); ++i) {
+    if (r.episode_event[i] < 0) {
+      if (spurious++ == 0) first = ", first at " + std::to_string(r.cycles[r.episodes[i].detect].time_ms) + " ms";
+    }
+  }
+  chk.ok = spurious == 0;
+  chk.detail = std::to_string(r.episodes.size()) + " detection(s), " + std::to_string(spurious) +
+               " without a simulated slip/slide" + first;
+  if (!chk.ok) {
+    st.failures.push_back(st.scenario.name + ": spurious detection: " + chk.detail);
+  }
+  st.checks.push_back(chk);
+}
+
 void CheckSensorFaults(ScenarioStudy& st) {
   const StudyRun& r = st.primary;
   for (std::size_t f = 0; f < st.scenario.faults.size(); ++f) {
@@ -354,7 +381,10 @@ ScenarioStudy StudyScenario(const sim::WheelRailScenario& sc, const sim::WheelRa
   for (const SlipPhase& p : st.phases) {
     st.events.push_back(TruthEvent{p.id, p.kind, p.start_ms, p.end_ms});
   }
-  const odometry::OdometryConfig base = sim::OdometryConfigOf(sc, st.sections);
+  odometry::OdometryConfig base = sim::OdometryConfigOf(sc, st.sections);
+  // The odometry takes its initial front as the position at its first cycle (the initial
+  // balise fix is read there), not at the scenario's t = 0.
+  if (!st.sim.truth.empty()) base.initial_front_mm = std::llround(st.sim.truth.front().front_m * 1000.0);
   odometry::OdometryConfig primary = base;
   primary.method = Method::kImu;
   odometry::OdometryConfig single = primary;
@@ -372,6 +402,7 @@ ScenarioStudy StudyScenario(const sim::WheelRailScenario& sc, const sim::WheelRa
   CheckEnvelopeOf(st, st.single);
   CheckSafeReaction(st);
   CheckSensorFaults(st);
+  CheckNoSpuriousDetection(st);
   return st;
 }
 

@@ -155,11 +155,19 @@ void Odometry::Record(std::size_t c, HistoryEntry& e) const noexcept {
 // averages (A_p) and start points use the compensated speed, position and pitch and not
 // the slipping TG's. Bounded by the candidate's age (<= history_cycles).
 // @implements REQ-RA-005
+//
+// The replaced speeds are blended linearly from the compensated speed at the start point to
+// the measured TG speed at `last`: the re-adhesion judgement accepts a difference of up to
+// readhesion_rate x t between them, and a step of that size in the history would come back
+// 3 s later as a TG acceleration (A_p) of up to 0.17 m/s^2 and raise a spurious deviation
+// (seen at standstill after a slide on -35 permille: repeated detections every 3.3 s).
 void Odometry::ReplaceTg(std::size_t c, std::int64_t last) noexcept {
   const std::int64_t first = std::max(cand_[c].start + 1, Oldest());
+  const double step = At(last).v_tg - At(last).cand_v[c];
+  const double span = static_cast<double>(std::max<std::int64_t>(last - cand_[c].start, 1));
   for (std::int64_t j = first; j <= last; ++j) {
     HistoryEntry& e = At(j);
-    e.v_tg = e.cand_v[c];
+    e.v_tg = e.cand_v[c] + step * (static_cast<double>(j - cand_[c].start) / span);
     e.front_um = std::llround(e.cand_x_um[c]);
     e.theta_comp = e.cand_theta[c];
     e.comp = true;

@@ -42,24 +42,32 @@ std::string WheelRailCsv(const WheelRailRun& run) {
       "tg_wheel_speed_mps,imu_count,ax_mean,ay_mean,az_mean,wx_mean,wy_mean,wz_mean,creep0,creep1,creep2,"
       "creep3,creep_peak0,creep_peak1,creep_peak2,creep_peak3,gradient_permille,pitch_rad,roll_rad,"
       "curvature_1pm,traction,brake,balise_mm,faults\n";
+  // Fields are appended one by one (operator+ chains on temporaries trip a false
+  // -Wrestrict in g++ 12 at -O3).
+  const auto field = [&out](const std::string& v) {
+    out += ',';
+    out += v;
+  };
   for (std::size_t i = 0; i < run.cycles.size(); ++i) {
     const auto& c = run.cycles[i];
     const auto& t = run.truth[i];
-    out += std::to_string(c.time_ms) + "," + F(t.front_m, 4) + "," + F(t.distance_m, 4) + "," + F(t.speed_mps, 5) +
-           "," + F(t.accel_mps2, 5) + "," + std::to_string(c.tg.pulses) + "," + std::to_string(c.tg.last_edge_us) +
-           "," + F(t.tg_distance_m, 4) + "," + F(t.tg_wheel_speed_mps, 5) + "," + std::to_string(c.imu_count) + "," +
-           F(Mean(c, &odometry::ImuSample::ax)) + "," + F(Mean(c, &odometry::ImuSample::ay)) + "," +
-           F(Mean(c, &odometry::ImuSample::az)) + "," + F(Mean(c, &odometry::ImuSample::wx), 8) + "," +
-           F(Mean(c, &odometry::ImuSample::wy), 8) + "," + F(Mean(c, &odometry::ImuSample::wz), 8);
-    for (const double v : t.creep) {
-      out += "," + F(v, 6);
+    out += std::to_string(c.time_ms);
+    for (const std::string& v :
+         {F(t.front_m, 4), F(t.distance_m, 4), F(t.speed_mps, 5), F(t.accel_mps2, 5), std::to_string(c.tg.pulses),
+          std::to_string(c.tg.last_edge_us), F(t.tg_distance_m, 4), F(t.tg_wheel_speed_mps, 5),
+          std::to_string(c.imu_count), F(Mean(c, &odometry::ImuSample::ax)), F(Mean(c, &odometry::ImuSample::ay)),
+          F(Mean(c, &odometry::ImuSample::az)), F(Mean(c, &odometry::ImuSample::wx), 8),
+          F(Mean(c, &odometry::ImuSample::wy), 8), F(Mean(c, &odometry::ImuSample::wz), 8)}) {
+      field(v);
     }
-    for (const double v : t.creep_peak) {
-      out += "," + F(v, 6);
+    for (const double v : t.creep) field(F(v, 6));
+    for (const double v : t.creep_peak) field(F(v, 6));
+    for (const std::string& v :
+         {F(t.gradient_permille, 3), F(t.pitch_rad, 7), F(t.roll_rad, 7), F(t.curvature_1pm, 8), F(t.traction, 4),
+          F(t.brake, 4), c.balise ? std::to_string(c.balise->front_mm) : std::string(), std::to_string(t.faults)}) {
+      field(v);
     }
-    out += "," + F(t.gradient_permille, 3) + "," + F(t.pitch_rad, 7) + "," + F(t.roll_rad, 7) + "," +
-           F(t.curvature_1pm, 8) + "," + F(t.traction, 4) + "," + F(t.brake, 4) + "," +
-           (c.balise ? std::to_string(c.balise->front_mm) : std::string()) + "," + std::to_string(t.faults) + "\n";
+    out += '\n';
   }
   return out;
 }

@@ -101,7 +101,7 @@ struct OdometryConfig {
   std::int64_t decel_max_mm_s2 = 1400;
   const OdometrySection* sections = nullptr;  // copied at Create, ordered, contiguous
   int section_count = 0;
-  std::int64_t initial_front_mm = 0;          // from the initial balise fix
+  std::int64_t initial_front_mm = 0;          // front at the first cycle (initial balise fix)
 };
 
 enum class ConfigError : std::uint8_t {
