@@ -37,7 +37,7 @@ std::vector<CycleInput> MakeStream(int cycles, int slip_from, bool noisy_jerk) {
   std::vector<CycleInput> out;
   out.reserve(static_cast<std::size_t>(cycles));
   const double v = 12.0;
-  double x = 0, xw = 0, slip = 0;
+  double xw = 0, slip = 0;  // wheel distance and slip speed
   std::int64_t pulses = 0, edge = 0, t_ms = 1'000;
   for (int k = 0; k < cycles; ++k) {
     t_ms += 100;
@@ -45,7 +45,6 @@ std::vector<CycleInput> MakeStream(int cycles, int slip_from, bool noisy_jerk) {
     for (int ms = 1; ms <= 100; ++ms) {
       const double s1 = slip + (slip_end - slip) * ms / 100.0;
       const double xw0 = xw;
-      x += v * 0.001;
       xw += (v + s1) * 0.001;
       while (std::floor(xw / kPulseM) > static_cast<double>(pulses)) {
         ++pulses;
