@@ -29,7 +29,8 @@ def generate(spec_dir: Path, out_dir: Path):
     areas = spec_mod.load_parameters(spec_dir)
     for area, data in sorted(areas.items()):
         name = {"TG": "telegram", "MB": "moving_block", "BR": "braking",
-                "SC": "speed_check", "RA": "readhesion"}.get(area, area.lower())
+                "SC": "speed_check", "RA": "readhesion",
+                "LC": "level_crossing"}.get(area, area.lower())
         lines = [
             "// Generated from spec/parameters by railproof_testgen gen-params. Do not edit.",
             "#pragma once",
