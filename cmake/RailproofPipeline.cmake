@@ -179,8 +179,28 @@ if(TARGET odometry_study)
   list(APPEND _odometry_outputs ${_study})
 endif()
 
+# Level crossings (spec/design/level-crossing.md): warning times of every crossing of the D4
+# line under the timetable, for fixed treadles, on-board requests (with and without dwell
+# awareness) and GNSS-time pre-arming; exits non-zero on any warning below the design time.
+set(_crossing_outputs)
+if(TARGET warning_study)
+  set(_wstudy ${RAILPROOF_RESULTS_DIR}/analysis/warning_study.json)
+  add_custom_command(
+    OUTPUT ${_wstudy}
+    COMMAND ${CMAKE_COMMAND} -E make_directory ${RAILPROOF_RESULTS_DIR}/analysis ${RAILPROOF_RESULTS_DIR}/level_crossing
+    COMMAND warning_study --line ${RAILPROOF_GEN_DIR}/lines/d4_local_line.json
+            --timetable ${RAILPROOF_SOURCE_DIR}/spec/timetables/d4_local_line.yaml
+            --trains-dir ${RAILPROOF_GEN_DIR}/trains --json ${_wstudy}
+            --svg-dir ${RAILPROOF_RESULTS_DIR}/level_crossing --quiet
+    DEPENDS warning_study ${RAILPROOF_SOURCE_DIR}/spec/timetables/d4_local_line.yaml
+            ${RAILPROOF_TRAIN_JSON} ${RAILPROOF_LINE_JSON}
+    COMMENT "analysis: level-crossing warning times (treadles, on-board request, GNSS time)"
+    USES_TERMINAL VERBATIM)
+  list(APPEND _crossing_outputs ${_wstudy})
+endif()
+
 add_custom_target(railproof_analysis_results ALL DEPENDS ${_residual} ${_scenario_outputs} ${_braking_outputs}
-                  ${_odometry_outputs})
+                  ${_odometry_outputs} ${_crossing_outputs})
 
 set(_tools ${RAILPROOF_RESULTS_DIR}/tool-versions.json)
 add_custom_command(
@@ -197,7 +217,7 @@ add_custom_command(
   COMMAND ${RAILPROOF_TESTGEN} trace --spec ${RAILPROOF_SOURCE_DIR}/spec --src ${RAILPROOF_SOURCE_DIR}
           --results ${RAILPROOF_RESULTS_DIR} --out ${_trace}
   DEPENDS ${_spin_outputs} ${_vector_outputs} ${_residual} ${_scenario_outputs} ${_braking_outputs}
-          ${_odometry_outputs} ${_traced_sources} ${_proof_sources} ${RAILPROOF_SPEC_FILES}
+          ${_odometry_outputs} ${_crossing_outputs} ${_traced_sources} ${_proof_sources} ${RAILPROOF_SPEC_FILES}
   COMMENT "trace: requirement <-> property/vector/code/test links" VERBATIM)
 
 set(_manifest ${CMAKE_BINARY_DIR}/evidence/manifest.json)
@@ -207,7 +227,7 @@ add_custom_command(
   COMMAND ${RAILPROOF_TESTGEN} evidence --spec ${RAILPROOF_SOURCE_DIR}/spec --results ${RAILPROOF_RESULTS_DIR}
           --src ${RAILPROOF_SOURCE_DIR} --out ${CMAKE_BINARY_DIR}/evidence --tool-versions ${_tools}
   DEPENDS ${_trace} ${_evidence_tests} ${_residual} ${_scenario_outputs} ${_braking_outputs} ${_tools}
-          ${_odometry_outputs}
+          ${_odometry_outputs} ${_crossing_outputs}
           ${_evidence_sources}
   COMMENT "evidence: rendering the assessor's package (Sphinx + sphinx-needs)" USES_TERMINAL VERBATIM)
 add_custom_target(evidence DEPENDS ${_manifest})

@@ -290,6 +290,8 @@ class Inputs:
     proofs: list = field(default_factory=list)          # [(rel, data)] of proofs/*.json
     braking_plots: list = field(default_factory=list)   # [(name, Path of braking/<name>.svg)]
     odometry_plots: list = field(default_factory=list)  # [(name, Path of odometry/<name>.svg)]
+    crossing_plots: list = field(default_factory=list)  # [(name, Path of level_crossing/<name>.svg)]
+    peer_check: list = field(default_factory=list)      # rows of the level-crossing peer cross-check
     justifications: dict = field(default_factory=dict)  # UR id -> entry (spec/justifications)
     model_sources: dict = field(default_factory=dict)   # model path -> text (None: not found)
     model_copies: dict = field(default_factory=dict)    # model path -> its copy under inputs/
@@ -593,6 +595,36 @@ def _load_chapter_plots(inp: Inputs, subdir: str, plots: list) -> None:
         inp.files.append(InputFile(f, f"results/{rel}"))
 
 
+PEER_CHECK_NOTE = "design/level-crossing.md"
+ID_TOKEN = re.compile(r"\b(?:REQ|HAZ|ASM)-[A-Z0-9]+(?:-[0-9]+)?\b")
+
+
+def _load_peer_check(inp: Inputs) -> None:
+    """The peer cross-check of the level-crossing design note (§7): the first Markdown table
+    of that section, one row per failure mode of the classic radio-based level-crossing case
+    study with the railproof property, requirement or assumption that covers it."""
+    note = inp.spec_dir / PEER_CHECK_NOTE
+    if not note.is_file():
+        return
+    inp.files.append(InputFile(note, f"spec/{PEER_CHECK_NOTE}"))
+    text = note.read_text(encoding="utf-8")
+    start = re.search(r"^## 7\. Peer cross-check", text, re.M)
+    if not start:
+        return
+    section = text[start.end():]
+    end = re.search(r"^## ", section, re.M)
+    section = section[:end.start()] if end else section
+    rows = [ln.strip() for ln in section.splitlines() if ln.strip().startswith("|")]
+    if len(rows) < 3:
+        return
+    cells = [[c.strip() for c in r.strip("|").split("|")] for r in rows]
+    header, body = cells[0], [c for c in cells[2:] if any(c)]
+    for i, c in enumerate(body):
+        _require(len(c) == len(header), note, f"§7 table row {i + 1}",
+                 f"{len(c)} cells where the header has {len(header)}")
+    inp.peer_check = [dict(zip(header, c)) for c in body]
+
+
 def _load_tool_versions(inp: Inputs, path: Path | None) -> None:
     if path is None:
         inp.missing.append("tool versions (--tool-versions)")
@@ -619,6 +651,8 @@ def load_inputs(spec_dir: Path, results_dir: Path, repo_root: Path,
     _load_proofs(inp)
     _load_chapter_plots(inp, "braking", inp.braking_plots)
     _load_chapter_plots(inp, "odometry", inp.odometry_plots)
+    _load_chapter_plots(inp, "level_crossing", inp.crossing_plots)
+    _load_peer_check(inp)
     _load_tool_versions(inp, Path(tool_versions) if tool_versions else None)
     return inp
 
@@ -717,6 +751,7 @@ class Model:
         self._moving_block()
         self._braking()
         self._readhesion()
+        self._level_crossing()
         self._versions()
         self._verdict()
 
@@ -1522,6 +1557,31 @@ class Model:
         ra["present"] = bool(ra["requirements"] or ra["model"] or ra["study"])
         self.ra = ra
 
+    # -- level-crossing chapter ----------------------------------------------------------
+    def _level_crossing(self):
+        """The data of the level-crossing chapter: REQ-LC requirements, the level_crossing
+        model's runs, mutants, goal coverage, vectors and conformance, the warning-time study
+        and its plots, and the peer cross-check (every identifier it names must exist)."""
+        lc = self._capability(("REQ-LC-",), "level_crossing", "conformance_lc")
+        lc["study"] = next((a for a in self.analyses if a["stem"] == "warning_study"), None)
+        lc["plots"] = [{"name": n, "src": f"crossing_plots/{n}.svg"}
+                       for n, _ in self.inp.crossing_plots]
+        known = set(self.req_ids) | {a["id"] for a in self.inp.assumptions} \
+            | {h["id"] for h in self.inp.hazards}
+        rows = []
+        for r in self.inp.peer_check:
+            text = " ".join(r.values())
+            ids = sorted(set(ID_TOKEN.findall(text)))
+            unknown = [i for i in ids if i not in known]
+            if unknown:
+                self.problems.append(f"peer cross-check (spec/{PEER_CHECK_NOTE} §7) names unknown "
+                                     f"identifier(s) {', '.join(unknown)}")
+            rows.append({"cells": list(r.values()), "ids": ids})
+        lc["peer_header"] = list(self.inp.peer_check[0].keys()) if self.inp.peer_check else []
+        lc["peer_rows"] = rows
+        lc["present"] = bool(lc["requirements"] or lc["model"] or lc["study"])
+        self.lc = lc
+
     # -- braking chapter ------------------------------------------------------------------
     def _braking(self):
         """The data of the braking chapter: REQ-BR and REQ-SC requirements, the braking
@@ -1671,12 +1731,13 @@ def render_sources(model: Model, evidence_dir: Path, src_dir: Path) -> list:
                                                   "README.md"))
     env = _jinja_env(template_dir)
     pages = ["overview", "traceability", "hazards", "model_checking", "moving_block", "braking",
-             "readhesion", "test_generation", "tests", "analysis", "tool_versions", "manifest"]
+             "readhesion", "level_crossing", "test_generation", "tests", "analysis", "tool_versions", "manifest"]
     for name, path in model.inp.scenario_plots:     # embedded by the moving-block chapter
         (src_dir / "scenario_plots").mkdir(parents=True, exist_ok=True)
         shutil.copyfile(path, src_dir / "scenario_plots" / f"{name}.svg")
     for sub, plots in (("braking_plots", model.inp.braking_plots),     # braking chapter
-                       ("odometry_plots", model.inp.odometry_plots)):  # re-adhesion chapter
+                       ("odometry_plots", model.inp.odometry_plots),   # re-adhesion chapter
+                       ("crossing_plots", model.inp.crossing_plots)):  # level-crossing chapter
         for name, path in plots:
             (src_dir / sub).mkdir(parents=True, exist_ok=True)
             shutil.copyfile(path, src_dir / sub / f"{name}.svg")
