@@ -191,7 +191,7 @@ if(TARGET warning_study)
     COMMAND warning_study --line ${RAILPROOF_GEN_DIR}/lines/d4_local_line.json
             --timetable ${RAILPROOF_SOURCE_DIR}/spec/timetables/d4_local_line.yaml
             --trains-dir ${RAILPROOF_GEN_DIR}/trains --json ${_wstudy}
-            --svg-dir ${RAILPROOF_RESULTS_DIR}/level_crossing --quiet
+            --svg-dir ${RAILPROOF_RESULTS_DIR}/level_crossing --lead-sweep 6,8,10,12,14,16,18,20,24 --quiet
     DEPENDS warning_study ${RAILPROOF_SOURCE_DIR}/spec/timetables/d4_local_line.yaml
             ${RAILPROOF_TRAIN_JSON} ${RAILPROOF_LINE_JSON}
     COMMENT "analysis: level-crossing warning times (treadles, on-board request, GNSS time)"

@@ -31,7 +31,13 @@ Rules after the schema (entry names such as ``balises[B7]`` or ``gradients[3]``)
 - gradients, speed limits and radio cells cover [0, length) without gap or overlap
   (entries in increasing order);
 - curves and no-stop sections lie on the line, in increasing order, not overlapping;
-- balises lie strictly inside their track; level crossings strictly inside the line;
+- balises lie strictly inside their track;
+- level crossings (REQ-LC-016): road width and design warning time positive, the warning
+  time at least ``min_warning_time_ms`` (spec/parameters, area LC); the crossing's extent
+  ``[at - width/2, at + width/2)`` (rounded outwards to whole mm) strictly inside the line;
+  no two crossings overlap; a train of the design length standing with any part on the
+  crossing stands in a no-stop section (the extent widened by the design train's length
+  on both sides lies inside one no-stop section);
 - points lie on their track and inside exactly one virtual block (none: "point without a
   virtual block"; several: named), no two points share a block, ``reverse_to`` is another
   existing track;
@@ -121,14 +127,40 @@ def _schema_errors(validator, data, file, report):
     return n
 
 
-def _max_blocks(spec_dir):
-    """max_blocks of spec/parameters (MB), or None if not available."""
+def _int_parameter(spec_dir, area, pid):
+    """Integer parameter `pid` of `area` in spec/parameters, or None if not available."""
     try:
         params = spec_mod.load_parameters(spec_dir)
     except SpecError:
         return None
-    e = params.get("MB", {}).get("parameters", {}).get("max_blocks")
+    e = params.get(area, {}).get("parameters", {}).get(pid)
     return int(e["value"]) if e and isinstance(e.get("value"), int) else None
+
+
+def _max_blocks(spec_dir):
+    """max_blocks of spec/parameters (MB), or None if not available."""
+    return _int_parameter(spec_dir, "MB", "max_blocks")
+
+
+class _CrossingLimits:
+    """Level-crossing parameters of spec/parameters (LC), each None if not available:
+    ``min_warning_ms`` (lowest design warning time accepted) and ``default_warning_ms``
+    (the design warning time of a crossing that states none)."""
+
+    def __init__(self, min_warning_ms=None, default_warning_ms=None):
+        self.min_warning_ms, self.default_warning_ms = min_warning_ms, default_warning_ms
+
+    @classmethod
+    def from_spec(cls, spec_dir):
+        return cls(_int_parameter(spec_dir, "LC", "min_warning_time_ms"),
+                   _int_parameter(spec_dir, "LC", "default_warning_time_ms"))
+
+
+def crossing_extent(at_mm, width_mm):
+    """[near, far) of a crossing in mm, rounded outwards (spec/design/level-crossing.md §1):
+    at - ceil(width/2), at + ceil(width/2); symmetric, so mirroring keeps it exact."""
+    half = (width_mm + 1) // 2
+    return at_mm - half, at_mm + half
 
 
 # --------------------------------------------------------------------------- checker
@@ -136,8 +168,9 @@ def _max_blocks(spec_dir):
 class _Line:
     """Semantic checks and conversion of one schema-valid line file."""
 
-    def __init__(self, path, data, report, max_blocks):
+    def __init__(self, path, data, report, max_blocks, lc_limits=None):
         self.f, self.d, self.report, self.max_blocks = path, data, report, max_blocks
+        self.lc = lc_limits if lc_limits is not None else _CrossingLimits()
         self.ok = True
 
     def err(self, entry, reason):
@@ -388,16 +421,7 @@ class _Line:
                                 f"{b['track']} {_sec(lo, hi)} required)")
                 continue
             balises.append((b["id"], b["track"], at))
-        lcs = []
-        for i, lc in enumerate(d.get("level_crossings") or []):
-            entry = _label("level_crossings", lc, i)
-            at = self.mm(entry, "at_m", lc["at_m"])
-            if at is None:
-                continue
-            if not 0 < at < L:
-                self.err(entry, f"level crossing at {_m(at)} m is off the line (0, {_m(L)}) m")
-                continue
-            lcs.append((lc["id"], at))
+        lcs = self._level_crossings(L, train_mm, nostop)
 
         # ---- points
         # Points that fail a rule are reported once here; later rules skip what refers to
@@ -628,6 +652,68 @@ class _Line:
         return self._emit(kmp, rlines, grads, speeds, curves, balises, stations, points,
                           routes, lcs, cells, handovers, nostop, train_mm)
 
+    # ---- level crossings (REQ-LC-016)
+    def _level_crossings(self, L, train_mm, nostop):
+        """[(id, at, width, warning_ms)] of the valid crossings; every fault reported with
+        the crossing's entry and the reason."""
+        lcs = []
+        for i, lc in enumerate(self.d.get("level_crossings") or []):
+            entry = _label("level_crossings", lc, i)
+            at = self.mm(entry, "at_m", lc["at_m"])
+            width = self.mm(entry, "width_m", lc["width_m"])
+            ok = at is not None and width is not None
+            if width is not None and width <= 0:
+                self.err(entry, f"road width {_m(width)} m is not positive")
+                ok = False
+            if "warning_time_s" in lc:
+                warn = self._scaled(entry, "warning_time_s", lc["warning_time_s"], 1000,
+                                    "milliseconds")
+                if warn is None:
+                    ok = False
+                elif warn <= 0:
+                    self.err(entry, f"design warning time {warn / 1000:g} s is not positive")
+                    ok = False
+            elif self.lc.default_warning_ms is not None:
+                warn = self.lc.default_warning_ms
+            else:
+                self.err(entry, "no warning_time_s and no default_warning_time_ms in "
+                                "spec/parameters (area LC)")
+                warn, ok = None, False
+            if warn is not None and warn > 0 and self.lc.min_warning_ms is not None \
+                    and warn < self.lc.min_warning_ms:
+                self.err(entry, f"design warning time {warn / 1000:g} s is below "
+                                f"min_warning_time_ms {self.lc.min_warning_ms} ms "
+                                "(spec/parameters/level_crossing.yaml)")
+                ok = False
+            if not ok:
+                continue
+            near, far = crossing_extent(at, width)
+            if not (0 < near and far < L):
+                self.err(entry, f"level crossing {_sec(near, far)} (centre {_m(at)} m, road "
+                                f"width {_m(width)} m) is off the line (0, {_m(L)}) m")
+                continue
+            lcs.append({"id": lc["id"], "entry": entry, "at": at, "width": width,
+                        "warning_ms": warn, "range": (near, far)})
+        # overlap: in order of the near edge, each must begin at or after the previous end
+        prev = None
+        for c in sorted(lcs, key=lambda c: c["range"]):
+            if prev is not None and c["range"][0] < prev["range"][1]:
+                self.err(c["entry"], f"level crossing {_sec(*c['range'])} overlaps "
+                                     f"{prev['entry']} {_sec(*prev['range'])}")
+            if prev is None or c["range"][1] > prev["range"][1]:
+                prev = c
+        # no-stop sections: no train of the design length may stand on a crossing (judged
+        # only when every no-stop section was valid: one fault, one message)
+        if train_mm is not None and len(nostop) == len(self.d.get("no_stop_sections") or []):
+            for c in lcs:
+                a, b = c["range"][0] - train_mm, c["range"][1] + train_mm
+                if not any(na <= a and b <= nb for _, (na, nb), _ in nostop):
+                    self.err(c["entry"], f"no no-stop section contains {_sec(max(a, 0), min(b, L))}"
+                                         f" (the crossing {_sec(*c['range'])} widened by the "
+                                         f"design train's {_m(train_mm)} m on both sides): a "
+                                         "train could stop standing on the crossing")
+        return lcs
+
     def _unique(self, seen, key, entry, where):
         if key in seen:
             self.err(entry, f"duplicate id {key!r} (first used by {seen[key]})")
@@ -685,8 +771,10 @@ class _Line:
                             "automatic": r["automatic"]}
                            for r in sorted((r for r in routes if r["rl"] == rid),
                                            key=lambda r: r["id"])],
-                "level_crossings": [{"id": lid, "position_mm": p} for p, lid in
-                                    sorted((pos(at), lid) for lid, at in lcs)],
+                "level_crossings": [
+                    {"id": c["id"], "position_mm": pos(c["at"]), "width_mm": c["width"],
+                     "warning_time_ms": c["warning_ms"]}
+                    for c in sorted(lcs, key=lambda c, pos=pos: (pos(c["at"]), c["id"]))],
                 "radio_cells": [{"id": cid, "begin_mm": a, "end_mm": b} for a, b, cid in
                                 sorted((*sec(*r), cid) for _, r, cid in cells)],
                 "handovers": [{"id": hid, "position_mm": p} for p, hid in
@@ -736,6 +824,7 @@ def check_lines(spec_dir, report):
         report.error(exc.file, exc.entry, exc.reason)
         return outputs, refs
     max_blocks = _max_blocks(spec_dir)
+    lc_limits = _CrossingLimits.from_spec(spec_dir)
     for f in files:
         try:
             data = spec_mod.load_yaml(f)
@@ -747,7 +836,7 @@ def check_lines(spec_dir, report):
         name = data["name"]
         refs.append((f, name, "assumption", data["assumption"]))
         refs.extend((f, name, f"source[{i}]", s) for i, s in enumerate(data["source"]))
-        obj = _Line(f, data, report, max_blocks).check()
+        obj = _Line(f, data, report, max_blocks, lc_limits).check()
         if obj is not None:
             outputs[name] = obj
     return outputs, refs

@@ -89,9 +89,14 @@ def contract_problems(obj):
         sb = rl["system_boundary_mm"]
         if sb is not None and not 0 < sb <= L:
             bad.append(f"{rl['id']}: system boundary")
+        prev_far = None
         for lc in rl["level_crossings"]:
-            if not 0 <= lc["position_mm"] <= L:
+            near, far = lines.crossing_extent(lc["position_mm"], lc["width_mm"])
+            if not (lc["width_mm"] > 0 and lc["warning_time_ms"] > 0 and 0 < near and far < L):
                 bad.append(f"{rl['id']}: level crossing {lc['id']}")
+            if prev_far is not None and near < prev_far:
+                bad.append(f"{rl['id']}: level crossing {lc['id']} overlaps or is out of order")
+            prev_far = far
     return bad
 
 
@@ -181,6 +186,10 @@ def test_mini_line_converts_both_directions(line_spec, tmp_path):
     assert up["system_boundary_mm"] == 1_950_000 and down["system_boundary_mm"] is None
     assert down["handovers"] == [{"id": "H1", "position_mm": 1_000_000}]
     assert down["no_stop_sections"] == [{"id": "NS1", "begin_mm": 450_000, "end_mm": 550_000}]
+    # crossing: centre mirrored, width and design warning time in mm and ms
+    assert down["level_crossings"] == [{"id": "LC1", "position_mm": 500_000, "width_mm": 8_000,
+                                        "warning_time_ms": 30_000}]
+    assert up["level_crossings"][0]["position_mm"] == 1_500_000
     assert down["kilometre_posts"][0] == {"position_mm": 0, "kilometrage_mm": 12_000_000}
     assert obj["design_train_length_mm"] == 40_000
 
@@ -260,7 +269,7 @@ CASES = {
         "{id: B1, track: main, at_m: 50}", "{id: B1, track: main, at_m: 50.0005}",
         "balises[B1]", "at_m: 50.0005 is not a whole number of millimetres"),
     "level_crossing_off_the_line": (
-        "{id: LC1, at_m: 1500}", "{id: LC1, at_m: 2000}", "level_crossings[LC1]", "off the line"),
+        "{id: LC1, at_m: 1500,", "{id: LC1, at_m: 2000,", "level_crossings[LC1]", "off the line"),
     "system_boundary_off_the_line": (
         "system_boundary_m: 1950}", "system_boundary_m: 2000}", "running_lines[up]",
         "system boundary at 2000 m is off the line"),
@@ -358,7 +367,7 @@ CASES = {
         "radio_cells[C2]", "gap [1000, 1200) m after radio_cells[C1] not covered by radio cells"),
     # identifiers, kilometre posts, running lines, header
     "duplicate_id_across_sections": (
-        "{id: LC1, at_m: 1500}", "{id: B2, at_m: 1500}", "level_crossings[B2]",
+        "{id: LC1, at_m: 1500,", "{id: B2, at_m: 1500,", "level_crossings[B2]",
         "duplicate id 'B2' (first used by entry 2 of balises)"),
     "kilometre_posts_decreasing": (
         "{km: 11.0, at_m: 1000}", "{km: 9.5, at_m: 1000}", "kilometre_posts[1]",
@@ -380,7 +389,7 @@ CASES = {
         "{id: B1, track: main, at_m: 50}", "{id: B1, at_m: 50}", "balises[B1]",
         "'track' is a required property"),
     "misspelt_field": (
-        "{id: LC1, at_m: 1500}", "{id: LC1, at_km: 1.5}", "level_crossings[LC1]",
+        "{id: LC1, at_m: 1500,", "{id: LC1, at_km: 1.5,", "level_crossings[LC1]",
         "'at_m' is a required property"),
     "bad_route_position": (
         "points: P2, position: normal,", "points: P2, position: straight,",
@@ -400,6 +409,159 @@ def test_rule_violations_name_file_and_entry(line_spec, cli, tmp_path, case):
     assert r.has(MINI, entry, fragment), r.err
     assert r.lines[-1].startswith("lines: ") and "nothing written" in r.lines[-1]
     assert not out.exists()
+
+
+# --------------------------------------------------------------------------- level crossings
+# REQ-LC-016: every fault of the crossing data is an error naming file, crossing and reason.
+
+LC1 = "{id: LC1, at_m: 1500, width_m: 8, warning_time_s: 30}"
+LC_PARAMS = ("schema: railproof/parameters/1\narea: LC\nparameters:\n"
+             "  - {id: default_warning_time_ms, value: 30000, unit: ms, source: ASM-001, "
+             "requirements: [REQ-LC-002]}\n"
+             "  - {id: min_warning_time_ms, value: 15000, unit: ms, source: ASM-001, "
+             "requirements: [REQ-LC-016]}\n")
+
+
+def _crossing_error(line_spec, cli, tmp_path, new, entry, fragment, extra=None):
+    out = tmp_path / "out"
+    r = cli("lines", "--spec", line_spec((LC1, new), extra=extra), "--out", out)
+    assert r.rc == 1
+    assert r.has(MINI, entry, fragment), r.err
+    assert not out.exists()
+    return r
+
+
+# @verifies REQ-LC-016
+def test_crossing_whose_width_reaches_beyond_the_line_end(line_spec, cli, tmp_path):
+    # the centre lies on the line, the road does not: [1975, 2005) m
+    _crossing_error(line_spec, cli, tmp_path,
+                    "{id: LC1, at_m: 1990, width_m: 30, warning_time_s: 30}",
+                    "level_crossings[LC1]",
+                    "level crossing [1975, 2005) m (centre 1990 m, road width 30 m) is off the "
+                    "line (0, 2000) m")
+
+
+# @verifies REQ-LC-016
+def test_crossing_reaching_the_line_start(line_spec, cli, tmp_path):
+    _crossing_error(line_spec, cli, tmp_path, "{id: LC1, at_m: 3, width_m: 6, warning_time_s: 30}",
+                    "level_crossings[LC1]", "level crossing [0, 6) m (centre 3 m, road width 6 m) "
+                                            "is off the line")
+
+
+# @verifies REQ-LC-016
+@pytest.mark.parametrize("width", ["0", "-4"])
+def test_crossing_width_not_positive(line_spec, cli, tmp_path, width):
+    _crossing_error(line_spec, cli, tmp_path,
+                    f"{{id: LC1, at_m: 1500, width_m: {width}, warning_time_s: 30}}",
+                    "level_crossings[LC1]", f"road width {width} m is not positive")
+
+
+# @verifies REQ-LC-016
+@pytest.mark.parametrize("warn", ["0", "-30"])
+def test_crossing_warning_time_not_positive(line_spec, cli, tmp_path, warn):
+    _crossing_error(line_spec, cli, tmp_path,
+                    f"{{id: LC1, at_m: 1500, width_m: 8, warning_time_s: {warn}}}",
+                    "level_crossings[LC1]", f"design warning time {warn} s is not positive")
+
+
+# @verifies REQ-LC-016
+def test_crossing_warning_time_below_the_minimum(line_spec, cli, tmp_path):
+    _crossing_error(line_spec, cli, tmp_path,
+                    "{id: LC1, at_m: 1500, width_m: 8, warning_time_s: 14.999}",
+                    "level_crossings[LC1]",
+                    "design warning time 14.999 s is below min_warning_time_ms 15000 ms",
+                    extra={"parameters/level_crossing.yaml": LC_PARAMS})
+
+
+# @verifies REQ-LC-016
+def test_crossing_warning_time_at_the_minimum_is_accepted(line_spec, cli, tmp_path):
+    spec = line_spec((LC1, "{id: LC1, at_m: 1500, width_m: 8, warning_time_s: 15}"),
+                     extra={"parameters/level_crossing.yaml": LC_PARAMS})
+    r = cli("lines", "--spec", spec, "--out", tmp_path / "out")
+    assert r.rc == 0, r.err
+    obj = json.loads((tmp_path / "out/mini_line.json").read_text())
+    assert obj["running_lines"][0]["level_crossings"][0]["warning_time_ms"] == 15_000
+
+
+# @verifies REQ-LC-016
+def test_crossing_warning_time_not_whole_ms(line_spec, cli, tmp_path):
+    _crossing_error(line_spec, cli, tmp_path,
+                    "{id: LC1, at_m: 1500, width_m: 8, warning_time_s: 30.0005}",
+                    "level_crossings[LC1]", "warning_time_s: 30.0005 is not a whole number of "
+                                            "milliseconds")
+
+
+# @verifies REQ-LC-016
+def test_overlapping_crossings(line_spec, cli, tmp_path):
+    _crossing_error(line_spec, cli, tmp_path,
+                    LC1 + "\n  - {id: LC2, at_m: 1510, width_m: 14, warning_time_s: 30}",
+                    "level_crossings[LC2]",
+                    "level crossing [1503, 1517) m overlaps level_crossings[LC1] [1496, 1504) m")
+
+
+# @verifies REQ-LC-016
+def test_overlap_is_found_whatever_the_order(line_spec, cli, tmp_path):
+    _crossing_error(line_spec, cli, tmp_path,
+                    "{id: LC2, at_m: 1510, width_m: 14, warning_time_s: 30}\n  - " + LC1,
+                    "level_crossings[LC2]", "overlaps level_crossings[LC1]")
+
+
+def test_adjacent_crossings_do_not_overlap(line_spec, cli, tmp_path):
+    spec = line_spec((LC1, LC1 + "\n  - {id: LC2, at_m: 1506, width_m: 4, warning_time_s: 30}"))
+    r = cli("lines", "--spec", spec, "--out", tmp_path / "out")
+    assert r.rc == 0, r.err  # [1496, 1504) and [1504, 1508) touch
+
+
+def test_crossing_outside_every_no_stop_section(line_spec, cli, tmp_path):
+    spec = line_spec(("{id: NS1, from_m: 1450, to_m: 1550,",
+                      "{id: NS1, from_m: 1470, to_m: 1550,"))
+    r = cli("lines", "--spec", spec, "--out", tmp_path / "out")
+    assert r.rc == 1
+    assert r.has(MINI, "level_crossings[LC1]",
+                 "no no-stop section contains [1456, 1544) m (the crossing [1496, 1504) m widened "
+                 "by the design train's 40 m on both sides)"), r.err
+
+
+def test_crossing_width_rounded_outwards():
+    assert lines.crossing_extent(1_500_000, 8_000) == (1_496_000, 1_504_000)
+    assert lines.crossing_extent(1_500_000, 7_001) == (1_496_499, 1_503_501)
+    # mirrored (length 2000 m): the same extent in running coordinates
+    near, far = lines.crossing_extent(2_000_000 - 1_500_000, 7_001)
+    assert (2_000_000 - far, 2_000_000 - near) == (1_496_499, 1_503_501)
+
+
+def test_default_warning_time_from_the_parameters(line_spec, cli, tmp_path):
+    spec = line_spec((LC1, "{id: LC1, at_m: 1500, width_m: 8}"),
+                     extra={"parameters/level_crossing.yaml": LC_PARAMS})
+    r = cli("lines", "--spec", spec, "--out", tmp_path / "out")
+    assert r.rc == 0, r.err
+    obj = json.loads((tmp_path / "out/mini_line.json").read_text())
+    assert obj["running_lines"][1]["level_crossings"][0]["warning_time_ms"] == 30_000
+
+
+def test_crossing_without_warning_time_and_without_default(line_spec, cli, tmp_path):
+    _crossing_error(line_spec, cli, tmp_path, "{id: LC1, at_m: 1500, width_m: 8}",
+                    "level_crossings[LC1]", "no warning_time_s and no default_warning_time_ms")
+
+
+def test_crossing_without_width(line_spec, cli, tmp_path):
+    _crossing_error(line_spec, cli, tmp_path, "{id: LC1, at_m: 1500, warning_time_s: 30}",
+                    "level_crossings[LC1]", "'width_m' is a required property")
+
+
+def test_provided_crossings_meet_the_parameters(tmp_path):
+    from railproof_testgen import spec as spec_mod
+    lc = spec_mod.load_parameters(REPO / "spec")["LC"]["parameters"]
+    lines.generate(REPO / "spec", tmp_path)
+    n = 0
+    for name in PROVIDED:
+        obj = json.loads((tmp_path / f"{name}.json").read_text())
+        for rl in obj["running_lines"]:
+            for c in rl["level_crossings"]:
+                assert c["width_mm"] > 0
+                assert c["warning_time_ms"] >= lc["min_warning_time_ms"]["value"]
+                n += 1
+    assert n == 2 * (3 + 12)  # d1: 3, d4: 12 crossings, each in both directions
 
 
 def test_max_blocks_from_the_parameters(line_spec, cli, tmp_path):

@@ -8,6 +8,7 @@
 #include <string>
 #include <utility>
 
+#include "railproof/generated/level_crossing_params.hpp"
 #include "railproof/sim/json_reader.hpp"
 
 namespace railproof::sim {
@@ -78,6 +79,57 @@ void CheckDisjoint(const std::vector<JsonNode>& nodes, const std::vector<Section
       nodes[i].Fail("begins at " + Mm(sections[i].begin_mm) + " mm, before the previous entry ends (" +
                     Mm(sections[i - 1].end_mm) + "): entries must be sorted and not overlap");
     }
+  }
+}
+
+// Level crossings (REQ-LC-016): each names the crossing and the reason.
+// @implements REQ-LC-016
+void ReadLevelCrossings(const JsonNode& rn, std::int64_t length_mm, RunningLine& rl) {
+  namespace lcp = railproof::params::level_crossing;
+  std::set<std::string> ids;
+  for (const auto& n0 : rn.Key("level_crossings").Array()) {
+    LevelCrossing lc;
+    lc.id = ReadId(n0, ids);
+    const JsonNode n = n0.Labelled(lc.id);
+    n.AllowOnly({"id", "position_mm", "width_mm", "warning_time_ms"});
+    lc.position_mm = ReadPosition(n.Key("position_mm"), length_mm);
+    lc.width_mm = n.Key("width_mm").Int();
+    if (lc.width_mm <= 0) {
+      n.Key("width_mm").Fail("level crossing " + lc.id + ": road width " + Mm(lc.width_mm) + " mm is not positive");
+    }
+    if (lc.width_mm >= length_mm) {
+      n.Key("width_mm").Fail("level crossing " + lc.id + ": road width " + Mm(lc.width_mm) +
+                             " mm is not less than the line length " + Mm(length_mm));
+    }
+    lc.warning_time_ms = n.Key("warning_time_ms").Int();
+    if (lc.warning_time_ms <= 0) {
+      n.Key("warning_time_ms")
+          .Fail("level crossing " + lc.id + ": design warning time " + std::to_string(lc.warning_time_ms) +
+                " ms is not positive");
+    }
+    if (lc.warning_time_ms < lcp::min_warning_time_ms) {
+      n.Key("warning_time_ms")
+          .Fail("level crossing " + lc.id + ": design warning time " + std::to_string(lc.warning_time_ms) +
+                " ms is below min_warning_time_ms " + std::to_string(lcp::min_warning_time_ms) + " ms");
+    }
+    if (lc.NearMm() <= 0 || lc.FarMm() >= length_mm) {
+      n.Fail("level crossing " + lc.id + " [" + Mm(lc.NearMm()) + ", " + Mm(lc.FarMm()) + ") mm (centre " +
+             Mm(lc.position_mm) + ", road width " + Mm(lc.width_mm) + ") lies off the line (0, " + Mm(length_mm) + ")");
+    }
+    if (!rl.level_crossings.empty()) {
+      const LevelCrossing& prev = rl.level_crossings.back();
+      if (lc.position_mm < prev.position_mm) {
+        n.Fail("level crossing " + lc.id + " at " + Mm(lc.position_mm) + " mm listed after " + prev.id + " at " +
+               Mm(prev.position_mm) + " mm (must be sorted)");
+      }
+      // sorted by centre: a crossing clear of its predecessor also ends after it, so the
+      // predecessor is the only one it can overlap
+      if (lc.NearMm() < prev.FarMm()) {
+        n.Fail("level crossing " + lc.id + " [" + Mm(lc.NearMm()) + ", " + Mm(lc.FarMm()) + ") mm overlaps " + prev.id +
+               " [" + Mm(prev.NearMm()) + ", " + Mm(prev.FarMm()) + ") mm");
+      }
+    }
+    rl.level_crossings.push_back(lc);
   }
 }
 
@@ -242,15 +294,7 @@ RunningLine ReadRunningLine(const JsonNode& rn0, std::set<std::string>& running_
       rl.routes.push_back(r);
     }
   }
-  {
-    std::set<std::string> ids;
-    for (const auto& n0 : rn.Key("level_crossings").Array()) {
-      LevelCrossing lc;
-      lc.id = ReadId(n0, ids);
-      lc.position_mm = ReadPosition(n0.Labelled(lc.id).Key("position_mm"), L);
-      rl.level_crossings.push_back(lc);
-    }
-  }
+  ReadLevelCrossings(rn, L, rl);
   {
     std::set<std::string> ids;
     const JsonNode cn = rn.Key("radio_cells");

@@ -73,9 +73,18 @@ struct Route {
   bool automatic = false;
 };
 
+// A level crossing on one running line (spec/design/level-crossing.md §1): centre, road
+// width along the track and design warning time (default applied by the converter).
+// It occupies [NearMm(), FarMm()) in the running direction, rounded outwards.
 struct LevelCrossing {
   std::string id;
-  std::int64_t position_mm = 0;
+  std::int64_t position_mm = 0;      // centre of the road
+  std::int64_t width_mm = 0;         // road width along the track, > 0
+  std::int64_t warning_time_ms = 0;  // design warning time, >= min_warning_time_ms
+
+  [[nodiscard]] std::int64_t HalfWidthMm() const { return (width_mm + 1) / 2; }
+  [[nodiscard]] std::int64_t NearMm() const { return position_mm - HalfWidthMm(); }
+  [[nodiscard]] std::int64_t FarMm() const { return position_mm + HalfWidthMm(); }
 };
 
 struct RadioCell {
@@ -125,8 +134,10 @@ struct Line {
   [[nodiscard]] const RunningLine& Running(std::string_view running_id) const;
 };
 
-// Parses and validates a line JSON text; `file` names it in messages.
-// @implements REQ-MB-020
+// Parses and validates a line JSON text; `file` names it in messages. Level crossings are
+// rejected (REQ-LC-016) when the extent leaves the line (0, length), the width or warning
+// time is not positive, the warning time is below min_warning_time_ms, or two overlap.
+// @implements REQ-MB-020 REQ-LC-016
 Line ParseLine(std::string_view text, const std::string& file);
 
 // Reads and parses a file (InputError if it cannot be read).
