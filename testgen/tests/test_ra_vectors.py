@@ -203,7 +203,8 @@ def test_vectors_are_schema_valid_and_cover_every_goal(generated):
             assert ("ONESTART-" in v["id"]) == one
     ann = spin.parse_annotations(MODEL)
     assert cov["labelled"] == len(ann.goals)
-    justifications = yaml.safe_load((REPO / "spec" / "justifications" / "readhesion.yaml").read_text())
+    jfile = REPO / "spec" / "justifications" / "readhesion.yaml"  # none while every goal is reached
+    justifications = yaml.safe_load(jfile.read_text()) if jfile.is_file() else {"justifications": []}
     justified = {j["goal"]: j["id"] for j in justifications["justifications"]}
     for g in cov["goals"]:  # reached with a vector, or justified
         if g["status"] == "reached":
@@ -253,10 +254,16 @@ def test_vectors_follow_the_design_note(generated):
                     assert o["max_compensation_cycles"] <= i["section"]["max_compensation_cycles"]
                 if o["balise_reset"]:  # REQ-RA-012
                     assert i["balise"] and prev != "COMPENSATING"
-                if o["detected"]:
-                    assert o["candidates"][0]["age_cycles"] == i["start_age_cycles"]
-                    if points == 2:
-                        assert o["candidates"][1]["age_cycles"] == i["start_age_cycles"] + b["spacing"]
+                if o["detected"]:  # REQ-RA-004/010: ages from the start point, too old discarded
+                    t_max = o["max_compensation_cycles"]
+                    for k in range(points):
+                        age = i["start_age_cycles"] + k * b["spacing"]
+                        c = o["candidates"][k]
+                        if age <= t_max:
+                            assert c["active"] or o["mode"] != "COMPENSATING"
+                            assert not c["active"] or c["age_cycles"] == age
+                        else:
+                            assert not c["active"] and c["age_cycles"] == 0
                 prev = o["mode"]
 
 
