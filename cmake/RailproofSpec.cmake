@@ -7,14 +7,16 @@ file(MAKE_DIRECTORY ${RAILPROOF_GEN_INCLUDE}/railproof/generated ${RAILPROOF_GEN
 file(GLOB RAILPROOF_SPEC_FILES CONFIGURE_DEPENDS
   ${RAILPROOF_SOURCE_DIR}/spec/*/*.yaml ${RAILPROOF_SOURCE_DIR}/spec/schemas/*.json)
 file(GLOB RAILPROOF_TESTGEN_FILES CONFIGURE_DEPENDS ${RAILPROOF_SOURCE_DIR}/testgen/railproof_testgen/*.py)
-set(RAILPROOF_PARAM_HEADER ${RAILPROOF_GEN_INCLUDE}/railproof/generated/telegram_params.hpp
-    ${RAILPROOF_GEN_INCLUDE}/railproof/generated/moving_block_params.hpp
-    ${RAILPROOF_GEN_INCLUDE}/railproof/generated/braking_params.hpp
-    ${RAILPROOF_GEN_INCLUDE}/railproof/generated/speed_check_params.hpp)
-set(RAILPROOF_PARAM_PML ${RAILPROOF_GEN_DIR}/models/telegram_params.pml
-    ${RAILPROOF_GEN_DIR}/models/moving_block_params.pml
-    ${RAILPROOF_GEN_DIR}/models/braking_params.pml
-    ${RAILPROOF_GEN_DIR}/models/speed_check_params.pml)
+# One C++ header and one Promela header per parameter file, named after the file
+# (spec/parameters/<name>.yaml -> <name>_params.hpp / .pml; gen-params checks the name).
+file(GLOB _param_files CONFIGURE_DEPENDS ${RAILPROOF_SOURCE_DIR}/spec/parameters/*.yaml)
+set(RAILPROOF_PARAM_HEADER)
+set(RAILPROOF_PARAM_PML)
+foreach(f ${_param_files})
+  get_filename_component(n ${f} NAME_WE)
+  list(APPEND RAILPROOF_PARAM_HEADER ${RAILPROOF_GEN_INCLUDE}/railproof/generated/${n}_params.hpp)
+  list(APPEND RAILPROOF_PARAM_PML ${RAILPROOF_GEN_DIR}/models/${n}_params.pml)
+endforeach()
 add_custom_command(
   OUTPUT ${RAILPROOF_PARAM_HEADER} ${RAILPROOF_PARAM_PML}
   COMMAND ${RAILPROOF_TESTGEN} gen-params --spec ${RAILPROOF_SOURCE_DIR}/spec --out ${RAILPROOF_GEN_DIR}

@@ -5,9 +5,7 @@
 //
 // Exit status: 0 no invariant violated; 1 invariant violations; 2 bad input or error.
 #include <chrono>
-#include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <exception>
 #include <filesystem>
 #include <fstream>
@@ -15,11 +13,11 @@
 #include <optional>
 #include <sstream>
 #include <string>
-#include <string_view>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
+#include "railproof/sim/cli.hpp"
 #include "railproof/sim/line.hpp"
 #include "railproof/sim/output_file.hpp"
 #include "railproof/sim/scenario.hpp"
@@ -57,19 +55,9 @@ void PrintHelp() {
       "violated, 1 invariant violations, 2 bad input or error.\n");
 }
 
-[[noreturn]] void Usage(const std::string& reason) {
-  std::fprintf(stderr, "line_sim: %s (see --help)\n", reason.c_str());
-  std::exit(2);
-}
-
-double ParseKmh(std::string_view opt, const std::string& text) {
-  char* end = nullptr;
-  const double v = std::strtod(text.c_str(), &end);
-  if (end == text.c_str() || *end != '\0' || !std::isfinite(v) || v <= 0.0 || v > 400.0) {
-    Usage(std::string(opt) + ": not a speed in (0, 400] km/h: '" + text + "'");
-  }
-  return v;
-}
+// --leader-cap-kmh and every entry of --sweep-leader-cap.
+const railproof::sim::NumberRule kSpeedKmh{
+    .lo = 0.0, .hi = 400.0, .lo_open = true, .message = "{opt}: not a speed in (0, 400] km/h: '{value}'"};
 
 void WriteFile(const std::filesystem::path& path, const std::string& text) {
   railproof::sim::WriteFileAtomic(path, text);
@@ -100,54 +88,36 @@ struct Options {
 
 Options ParseArgs(int argc, char** argv) {
   Options o;
-  for (int i = 1; i < argc; ++i) {
-    const std::string_view a = argv[i];
-    auto value = [&]() -> std::string {
-      if (i + 1 >= argc) {
-        Usage(std::string(a) + " needs a value");
-      }
-      return argv[++i];
-    };
-    if (a == "--help" || a == "-h") {
-      PrintHelp();
-      std::exit(0);
-    } else if (a == "--scenario") {
-      o.scenario = value();
-    } else if (a == "--lines-dir") {
-      o.lines_dir = value();
-    } else if (a == "--log") {
-      o.log = value();
-    } else if (a == "--log-full") {
-      o.log_full = true;
-    } else if (a == "--svg") {
-      o.svg = value();
-    } else if (a == "--summary") {
-      o.summary = value();
-    } else if (a == "--quiet") {
-      o.quiet = true;
-    } else if (a == "--leader-cap-kmh") {
-      o.leader_cap = ParseKmh(a, value());
-    } else if (a == "--sweep-leader-cap") {
-      std::stringstream ss(value());
-      std::string item;
-      while (std::getline(ss, item, ',')) {
-        o.sweep.push_back(ParseKmh(a, item));
-      }
-      if (o.sweep.empty()) {
-        Usage("--sweep-leader-cap: empty list");
-      }
-    } else {
-      Usage("unknown option '" + std::string(a) + "'");
-    }
-  }
-  if (o.scenario.empty()) {
-    Usage("--scenario is required");
-  }
-  if (o.lines_dir.empty()) {
-    Usage("--lines-dir is required");
-  }
+  railproof::sim::CliParser cli({.tool = "line_sim", .unknown = railproof::sim::CliStyle::Unknown::kQuoted}, PrintHelp);
+  cli.Value("--scenario", o.scenario)
+      .Value("--lines-dir", o.lines_dir)
+      .Value("--log", o.log)
+      .Flag("--log-full", o.log_full)
+      .Value("--svg", o.svg)
+      .Value("--summary", o.summary)
+      .Flag("--quiet", o.quiet)
+      .Number("--leader-cap-kmh", [&](double v) { o.leader_cap = v; }, kSpeedKmh)
+      .Custom("--sweep-leader-cap",
+              [&](const std::string& list) -> std::optional<std::string> {
+                std::stringstream ss(list);
+                std::string item;
+                while (std::getline(ss, item, ',')) {
+                  double v = 0.0;
+                  if (auto error = railproof::sim::ParseCliNumber("--sweep-leader-cap", item, kSpeedKmh, v)) {
+                    return error;
+                  }
+                  o.sweep.push_back(v);
+                }
+                if (o.sweep.empty()) {
+                  return "--sweep-leader-cap: empty list";
+                }
+                return std::nullopt;
+              })
+      .Require("--scenario")
+      .Require("--lines-dir");
+  cli.ParseOrExit(argc, argv);
   if (!o.sweep.empty() && (!o.log.empty() || !o.svg.empty())) {
-    Usage("--sweep-leader-cap writes only --summary (no --log / --svg)");
+    cli.Fail("--sweep-leader-cap writes only --summary (no --log / --svg)");
   }
   return o;
 }

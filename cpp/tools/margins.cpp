@@ -13,7 +13,6 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <exception>
 #include <filesystem>
 #include <fstream>
@@ -24,7 +23,6 @@
 #include <optional>
 #include <sstream>
 #include <string>
-#include <string_view>
 #include <thread>
 #include <vector>
 
@@ -33,6 +31,7 @@
 #include "railproof/analysis/falsifier.hpp"
 #include "railproof/analysis/margins.hpp"
 #include "railproof/analysis/train_type.hpp"
+#include "railproof/sim/cli.hpp"
 #include "railproof/sim/line.hpp"
 #include "railproof/sim/output_file.hpp"
 #include "railproof/sim/svg.hpp"
@@ -87,11 +86,6 @@ void PrintHelp() {
       "a REQ-BR-010 finding, a falsifier violation or a failed NLP/grid cross-check; 2 bad input.\n");
 }
 
-[[noreturn]] void Usage(const std::string& reason) {
-  std::fprintf(stderr, "margins: %s (see --help)\n", reason.c_str());
-  std::exit(2);
-}
-
 struct Options {
   std::vector<std::string> lines;
   std::vector<std::string> trains;
@@ -110,71 +104,37 @@ struct Options {
   std::string details;  // per-location rows go here instead of into --json
 };
 
-double ParseNumber(std::string_view opt, const std::string& text, double lo, double hi) {
-  char* end = nullptr;
-  const double v = std::strtod(text.c_str(), &end);
-  if (end == text.c_str() || *end != '\0' || !std::isfinite(v) || v < lo || v > hi) {
-    Usage(std::string(opt) + ": not a number in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]: '" + text + "'");
-  }
-  return v;
+// A number option's rule: [lo, hi], one message for a malformed or out-of-range value.
+railproof::sim::NumberRule InRange(double lo, double hi) {
+  return {.lo = lo,
+          .hi = hi,
+          .message = "{opt}: not a number in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]: '{value}'"};
 }
 
 Options ParseArgs(int argc, char** argv) {
   Options o;
-  for (int i = 1; i < argc; ++i) {
-    const std::string_view a = argv[i];
-    auto value = [&]() -> std::string {
-      if (i + 1 >= argc) {
-        Usage(std::string(a) + " needs a value");
-      }
-      return argv[++i];
-    };
-    if (a == "--help" || a == "-h") {
-      PrintHelp();
-      std::exit(0);
-    } else if (a == "--line") {
-      o.lines.push_back(value());
-    } else if (a == "--train") {
-      o.trains.push_back(value());
-    } else if (a == "--json") {
-      o.json = value();
-    } else if (a == "--details") {
-      o.details = value();
-    } else if (a == "--svg-dir") {
-      o.svg_dir = value();
-    } else if (a == "--cases-dir") {
-      o.cases_dir = value();
-    } else if (a == "--falsify-budget-s") {
-      o.falsify_budget_s = ParseNumber(a, value(), 0.0, 3600.0);
-    } else if (a == "--falsify-per-class") {
-      o.falsify_per_class = static_cast<int>(ParseNumber(a, value(), 0, 1000));
-    } else if (a == "--nlp-per-class") {
-      o.nlp_per_class = static_cast<int>(ParseNumber(a, value(), 0, 100000));
-    } else if (a == "--nlp-all") {
-      o.nlp_all = true;
-    } else if (a == "--resolution-mm") {
-      o.resolution_mm = static_cast<std::int64_t>(ParseNumber(a, value(), 1, 100000));
-    } else if (a == "--threads") {
-      o.threads = static_cast<int>(ParseNumber(a, value(), 1, 256));
-    } else if (a == "--compare-methods") {
-      o.compare = true;
-    } else if (a == "--exclude-standstill-restart") {
-      o.exclude_standstill = true;
-    } else if (a == "--quiet") {
-      o.quiet = true;
-    } else {
-      Usage("unknown option '" + std::string(a) + "'");
-    }
-  }
-  if (o.lines.empty()) {
-    Usage("--line is required");
-  }
-  if (o.trains.empty()) {
-    Usage("--train is required");
-  }
-  if (o.json.empty()) {
-    Usage("--json is required");
-  }
+  railproof::sim::CliParser cli({.tool = "margins", .unknown = railproof::sim::CliStyle::Unknown::kQuoted}, PrintHelp);
+  // The counts and the step accept any number in range, truncated toward zero (2.9 -> 2).
+  cli.List("--line", o.lines)
+      .List("--train", o.trains)
+      .Value("--json", o.json)
+      .Value("--details", o.details)
+      .Value("--svg-dir", o.svg_dir)
+      .Value("--cases-dir", o.cases_dir)
+      .Number("--falsify-budget-s", o.falsify_budget_s, InRange(0.0, 3600.0))
+      .Number("--falsify-per-class", [&](double v) { o.falsify_per_class = static_cast<int>(v); }, InRange(0, 1000))
+      .Number("--nlp-per-class", [&](double v) { o.nlp_per_class = static_cast<int>(v); }, InRange(0, 100000))
+      .Flag("--nlp-all", o.nlp_all)
+      .Number("--resolution-mm", [&](double v) { o.resolution_mm = static_cast<std::int64_t>(v); },
+              InRange(1, 100000))
+      .Number("--threads", [&](double v) { o.threads = static_cast<int>(v); }, InRange(1, 256))
+      .Flag("--compare-methods", o.compare)
+      .Flag("--exclude-standstill-restart", o.exclude_standstill)
+      .Flag("--quiet", o.quiet)
+      .Require("--line")
+      .Require("--train")
+      .Require("--json");
+  cli.ParseOrExit(argc, argv);
   return o;
 }
 

@@ -19,14 +19,12 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <exception>
 #include <filesystem>
 #include <map>
 #include <mutex>
 #include <optional>
 #include <string>
-#include <string_view>
 #include <thread>
 #include <vector>
 
@@ -35,6 +33,7 @@
 #include "railproof/analysis/odometry_study.hpp"
 #include "railproof/analysis/train_type.hpp"
 #include "railproof/generated/readhesion_params.hpp"
+#include "railproof/sim/cli.hpp"
 #include "railproof/sim/line.hpp"
 #include "railproof/sim/output_file.hpp"
 #include "railproof/sim/wheel_rail.hpp"
@@ -82,11 +81,6 @@ void PrintHelp() {
       static_cast<long long>(rp::max_compensation_ms), static_cast<double>(rp::imu_rate_error_udeg_s) / 1e6);
 }
 
-[[noreturn]] void Usage(const std::string& reason) {
-  std::fprintf(stderr, "odometry_study: %s (see --help)\n", reason.c_str());
-  std::exit(2);
-}
-
 struct Options {
   std::string scenarios;
   std::string out_dir;
@@ -101,51 +95,19 @@ struct Options {
 
 Options ParseArgs(int argc, char** argv) {
   Options o;
-  for (int i = 1; i < argc; ++i) {
-    const std::string_view a = argv[i];
-    auto value = [&]() -> std::string {
-      if (i + 1 >= argc) {
-        Usage(std::string(a) + " needs a value");
-      }
-      return argv[++i];
-    };
-    if (a == "--help" || a == "-h") {
-      PrintHelp();
-      std::exit(0);
-    } else if (a == "--scenarios") {
-      o.scenarios = value();
-    } else if (a == "--out-dir") {
-      o.out_dir = value();
-    } else if (a == "--json") {
-      o.json = value();
-    } else if (a == "--trains-dir") {
-      o.trains_dir = value();
-    } else if (a == "--lines-dir") {
-      o.lines_dir = value();
-    } else if (a == "--cycles-dir") {
-      o.cycles_dir = value();
-    } else if (a == "--only") {
-      o.only.push_back(value());
-    } else if (a == "--threads") {
-      const std::string v = value();
-      char* end = nullptr;
-      const long n = std::strtol(v.c_str(), &end, 10);
-      if (end == v.c_str() || *end != '\0' || n < 1 || n > 64) {
-        Usage("--threads: expected 1..64, got '" + v + "'");
-      }
-      o.threads = static_cast<int>(n);
-    } else if (a == "--quiet") {
-      o.quiet = true;
-    } else {
-      Usage("unknown option: " + std::string(a));
-    }
-  }
-  if (o.scenarios.empty()) {
-    Usage("--scenarios is required");
-  }
-  if (o.out_dir.empty()) {
-    Usage("--out-dir is required");
-  }
+  railproof::sim::CliParser cli({.tool = "odometry_study"}, PrintHelp);
+  cli.Value("--scenarios", o.scenarios)
+      .Value("--out-dir", o.out_dir)
+      .Value("--json", o.json)
+      .Value("--trains-dir", o.trains_dir)
+      .Value("--lines-dir", o.lines_dir)
+      .Value("--cycles-dir", o.cycles_dir)
+      .List("--only", o.only)
+      .Integer("--threads", o.threads, {.lo = 1, .hi = 64, .message = "{opt}: expected 1..64, got '{value}'"})
+      .Flag("--quiet", o.quiet)
+      .Require("--scenarios")
+      .Require("--out-dir");
+  cli.ParseOrExit(argc, argv);
   return o;
 }
 

@@ -1,23 +1,22 @@
 // residual_error: rate of undetected erroneous telegrams of the link coding (REQ-TG-019).
 // Prints a table and optionally writes JSON (results/analysis/residual_error.json in the
 // pipeline). Defaults come from the generated parameters (spec/parameters/telegram.yaml).
-#include <cerrno>
-#include <charconv>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <exception>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <limits>
 #include <stdexcept>
 #include <string>
-#include <string_view>
+#include <utility>
 #include <vector>
 
 #include "railproof/analysis/residual_error.hpp"
 #include "railproof/generated/telegram_params.hpp"
 #include "railproof/radio/telegram.hpp"
+#include "railproof/sim/cli.hpp"
 
 namespace {
 
@@ -62,29 +61,24 @@ void PrintHelp() {
       static_cast<double>(tg::residual_target_per_h));
 }
 
-[[noreturn]] void Fail(const std::string& reason) {
-  std::fprintf(stderr, "residual_error: %s\n", reason.c_str());
-  std::exit(2);
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// A number of the command line (std::strtod, the whole text, finite, no range error).
+railproof::sim::NumberRule Finite(double lo, double hi, bool lo_open, std::string range_message) {
+  return {.lo = lo,
+          .hi = hi,
+          .lo_open = lo_open,
+          .reject_range_error = true,
+          .message = "{opt}: not a finite number: '{value}'",
+          .range_message = std::move(range_message)};
 }
 
-double ParseDouble(std::string_view opt, const char* text) {
-  errno = 0;
-  char* end = nullptr;
-  const double v = std::strtod(text, &end);
-  if (end == text || *end != '\0' || errno == ERANGE || !std::isfinite(v)) {
-    Fail(std::string(opt) + ": not a finite number: '" + text + "'");
-  }
-  return v;
-}
-
-unsigned ParseUnsigned(std::string_view opt, const char* text) {
-  const std::string_view s(text);
-  unsigned v = 0;
-  const auto [ptr, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
-  if (ec != std::errc() || ptr != s.data() + s.size()) {
-    Fail(std::string(opt) + ": not a non-negative integer: '" + text + "'");
-  }
-  return v;
+// A count of the command line (digits only, fits an unsigned).
+railproof::sim::IntegerRule Count(long long lo, std::string range_message) {
+  return {.lo = lo,
+          .digits_only = true,
+          .message = "{opt}: not a non-negative integer: '{value}'",
+          .range_message = std::move(range_message)};
 }
 
 }  // namespace
@@ -101,55 +95,19 @@ int main(int argc, char** argv) {
   std::vector<double> bers;
   std::string json_path;
 
-  for (int i = 1; i < argc; ++i) {
-    const std::string_view opt(argv[i]);
-    if (opt == "--help" || opt == "-h") {
-      PrintHelp();
-      return 0;
-    }
-    if (i + 1 >= argc) {
-      Fail(std::string("unknown option or missing value: ") + argv[i]);
-    }
-    const char* val = argv[++i];
-    if (opt == "--ber") {
-      const double b = ParseDouble(opt, val);
-      if (b < 0.0 || b > 1.0) {
-        Fail("--ber must be in [0, 1], got " + std::string(val));
-      }
-      bers.push_back(b);
-    } else if (opt == "--bit-rate") {
-      config.bit_rate_bps = ParseDouble(opt, val);
-      if (config.bit_rate_bps <= 0.0) {
-        Fail("--bit-rate must be positive");
-      }
-    } else if (opt == "--n") {
-      config.code.n = ParseUnsigned(opt, val);
-    } else if (opt == "--k") {
-      config.code.k = ParseUnsigned(opt, val);
-    } else if (opt == "--m") {
-      config.code.m = ParseUnsigned(opt, val);
-    } else if (opt == "--blocks") {
-      config.blocks = ParseUnsigned(opt, val);
-      if (config.blocks < 1U) {
-        Fail("--blocks must be >= 1");
-      }
-    } else if (opt == "--target") {
-      config.target_per_hour = ParseDouble(opt, val);
-      if (config.target_per_hour <= 0.0) {
-        Fail("--target must be positive");
-      }
-    } else if (opt == "--tag-pass") {
-      const double p = ParseDouble(opt, val);
-      if (p < 0.0 || p > 1.0) {
-        Fail("--tag-pass must be in [0, 1]");
-      }
-      config.tag_pass = static_cast<long double>(p);
-    } else if (opt == "--json") {
-      json_path = val;
-    } else {
-      Fail(std::string("unknown option: ") + argv[i - 1]);
-    }
-  }
+  railproof::sim::CliParser cli(
+      {.tool = "residual_error", .values = railproof::sim::CliStyle::Values::kPaired, .see_help = false}, PrintHelp);
+  cli.Number("--ber", bers, Finite(0.0, 1.0, false, "--ber must be in [0, 1], got {value}"))
+      .Number("--bit-rate", config.bit_rate_bps, Finite(0.0, kInf, true, "--bit-rate must be positive"))
+      .Integer("--n", config.code.n, Count(0, ""))
+      .Integer("--k", config.code.k, Count(0, ""))
+      .Integer("--m", config.code.m, Count(0, ""))
+      .Integer("--blocks", config.blocks, Count(1, "--blocks must be >= 1"))
+      .Number("--target", config.target_per_hour, Finite(0.0, kInf, true, "--target must be positive"))
+      .Number("--tag-pass", [&](double p) { config.tag_pass = static_cast<long double>(p); },
+              Finite(0.0, 1.0, false, "--tag-pass must be in [0, 1]"))
+      .Value("--json", json_path);
+  cli.ParseOrExit(argc, argv);
   if (bers.empty()) {  // the two bit error rates D5 reports (spec/parameters)
     bers.push_back(static_cast<double>(tg::design_ber));
     bers.push_back(static_cast<double>(tg::comparison_ber));
@@ -171,12 +129,12 @@ int main(int argc, char** argv) {
       out << railproof::analysis::ResidualReportJson(config, results);
       out.close();
       if (!out) {
-        Fail("cannot write " + json_path);
+        cli.Fail("cannot write " + json_path);
       }
       std::cout << "wrote " << json_path << "\n";
     }
   } catch (const std::exception& e) {
-    Fail(e.what());
+    cli.Fail(e.what());
   }
   return 0;
 }

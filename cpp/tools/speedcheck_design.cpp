@@ -8,7 +8,6 @@
 //
 // Exit status: 0 verdict pass; 1 verdict fail; 2 bad input or error.
 #include <algorithm>
-#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -16,6 +15,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <string_view>
@@ -25,6 +25,7 @@
 #include <nlohmann/json.hpp>
 
 #include "railproof/analysis/speedcheck_design.hpp"
+#include "railproof/sim/cli.hpp"
 #include "railproof/sim/json_reader.hpp"
 #include "railproof/sim/line.hpp"
 #include "railproof/sim/output_file.hpp"
@@ -73,15 +74,11 @@ void PrintHelp() {
   std::exit(2);
 }
 
-double ParsePositive(std::string_view opt, const char* text) {
-  errno = 0;
-  char* end = nullptr;
-  const double v = std::strtod(text, &end);
-  if (end == text || *end != '\0' || errno == ERANGE || !std::isfinite(v) || v <= 0.0) {
-    Fail(std::string(opt) + ": not a positive number: '" + text + "'");
-  }
-  return v;
-}
+// --n1f and --f1.
+const railproof::sim::NumberRule kPositive{.lo = 0.0,
+                                           .lo_open = true,
+                                           .reject_range_error = true,
+                                           .message = "{opt}: not a positive number: '{value}'"};
 
 struct TrainRow {
   std::string name;
@@ -381,44 +378,37 @@ int main(int argc, char** argv) {
   an::SpeedCheckInputs in = an::ReferenceSpeedCheckInputs();
   double n1f_opt = 0.0;
   double f1_opt = 0.0;
-  for (int i = 1; i < argc; ++i) {
-    const std::string_view opt(argv[i]);
-    if (opt == "--help" || opt == "-h") {
-      PrintHelp();
-      return 0;
-    }
-    if (i + 1 >= argc) {
-      Fail(std::string("unknown option or missing value: ") + argv[i]);
-    }
-    const char* val = argv[++i];
-    if (opt == "--train-json") {
-      train_files.emplace_back(val);
-    } else if (opt == "--json") {
-      json_path = val;
-    } else if (opt == "--svg") {
-      svg_path = val;
-    } else if (opt == "--target-basis") {
-      const std::string_view b(val);
-      if (b == "design-max") {
-        in.target_basis = an::TargetBasis::kDesignMaxSpeed;
-      } else if (b == "check-speed") {
-        in.target_basis = an::TargetBasis::kCheckSpeed;
-      } else {
-        Fail("--target-basis: expected design-max or check-speed, got '" + std::string(b) + "'");
-      }
-    } else if (opt == "--n1f") {
-      n1f_opt = ParsePositive(opt, val);
-      if (n1f_opt != std::floor(n1f_opt) || n1f_opt > 1e9) {
-        Fail("--n1f: expected a whole number 1..1e9, got '" + std::string(val) + "'");
-      }
-    } else if (opt == "--f1") {
-      f1_opt = ParsePositive(opt, val);
-    } else {
-      Fail("unknown option: " + std::string(opt));
-    }
-  }
+  railproof::sim::CliParser cli(
+      {.tool = "speedcheck_design", .values = railproof::sim::CliStyle::Values::kPaired, .see_help = false},
+      PrintHelp);
+  cli.List("--train-json", train_files)
+      .Value("--json", json_path)
+      .Value("--svg", svg_path)
+      .Custom("--target-basis",
+              [&](const std::string& b) -> std::optional<std::string> {
+                if (b == "design-max") {
+                  in.target_basis = an::TargetBasis::kDesignMaxSpeed;
+                } else if (b == "check-speed") {
+                  in.target_basis = an::TargetBasis::kCheckSpeed;
+                } else {
+                  return "--target-basis: expected design-max or check-speed, got '" + b + "'";
+                }
+                return std::nullopt;
+              })
+      .Custom("--n1f",
+              [&](const std::string& v) -> std::optional<std::string> {
+                if (auto error = railproof::sim::ParseCliNumber("--n1f", v, kPositive, n1f_opt)) {
+                  return error;
+                }
+                if (n1f_opt != std::floor(n1f_opt) || n1f_opt > 1e9) {
+                  return "--n1f: expected a whole number 1..1e9, got '" + v + "'";
+                }
+                return std::nullopt;
+              })
+      .Number("--f1", f1_opt, kPositive);
+  cli.ParseOrExit(argc, argv);
   if ((n1f_opt > 0.0) != (f1_opt > 0.0)) {
-    Fail("--n1f and --f1 go together");
+    cli.Fail("--n1f and --f1 go together");
   }
 
   try {

@@ -6,11 +6,10 @@
 // Exit status: 0 done; 2 bad input or error.
 #include <chrono>
 #include <cstdio>
-#include <cstdlib>
 #include <exception>
 #include <string>
-#include <string_view>
 
+#include "railproof/sim/cli.hpp"
 #include "railproof/sim/output_file.hpp"
 #include "railproof/sim/wheel_rail.hpp"
 
@@ -36,11 +35,6 @@ void PrintHelp() {
       "input or error.\n");
 }
 
-[[noreturn]] void Usage(const std::string& reason) {
-  std::fprintf(stderr, "wheelrail_sim: %s (see --help)\n", reason.c_str());
-  std::exit(2);
-}
-
 struct Options {
   std::string scenario;
   std::string csv;
@@ -50,32 +44,14 @@ struct Options {
 
 Options ParseArgs(int argc, char** argv) {
   Options o;
-  for (int i = 1; i < argc; ++i) {
-    const std::string_view a = argv[i];
-    auto value = [&]() -> std::string {
-      if (i + 1 >= argc) {
-        Usage(std::string(a) + " needs a value");
-      }
-      return argv[++i];
-    };
-    if (a == "--help" || a == "-h") {
-      PrintHelp();
-      std::exit(0);
-    } else if (a == "--scenario") {
-      o.scenario = value();
-    } else if (a == "--csv") {
-      o.csv = value();
-    } else if (a == "--json") {
-      o.json = value();
-    } else if (a == "--quiet") {
-      o.quiet = true;
-    } else {
-      Usage("unknown option '" + std::string(a) + "'");
-    }
-  }
-  if (o.scenario.empty()) {
-    Usage("--scenario is required");
-  }
+  railproof::sim::CliParser cli({.tool = "wheelrail_sim", .unknown = railproof::sim::CliStyle::Unknown::kQuoted},
+                                PrintHelp);
+  cli.Value("--scenario", o.scenario)
+      .Value("--csv", o.csv)
+      .Value("--json", o.json)
+      .Flag("--quiet", o.quiet)
+      .Require("--scenario");
+  cli.ParseOrExit(argc, argv);
   return o;
 }
 

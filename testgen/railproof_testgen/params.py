@@ -31,6 +31,10 @@ def generate(spec_dir: Path, out_dir: Path):
         name = {"TG": "telegram", "MB": "moving_block", "BR": "braking",
                 "SC": "speed_check", "RA": "readhesion",
                 "LC": "level_crossing"}.get(area, area.lower())
+        if Path(data["file"]).stem != name:  # the build declares <file stem>_params.* as outputs
+            raise spec_mod.SpecError(data["file"], "area",
+                                     f"area {area} generates {name}_params.*: the file must be "
+                                     f"named {name}.yaml")
         lines = [
             "// Generated from spec/parameters by railproof_testgen gen-params. Do not edit.",
             "#pragma once",
