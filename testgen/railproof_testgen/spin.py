@@ -8,6 +8,7 @@ command with the counterexample shown; so does a surviving mutant.
 """
 from __future__ import annotations
 
+import errno
 import hashlib
 import json
 import os
@@ -169,7 +170,19 @@ def read_bounds(params_pml: Path) -> dict:
 
 
 def _run(cmd, cwd, timeout=None):
-    return subprocess.run(cmd, cwd=cwd, capture_output=True, text=True, timeout=timeout, check=False)
+    """Run a command. Executing a freshly linked ./pan can fail with ETXTBSY ("text file
+    busy") while the thread pool forks another child that still holds the linker's write
+    descriptor for a moment (seen under load in a fresh build); that is retried, anything
+    else is raised."""
+    for attempt in range(20):
+        try:
+            return subprocess.run(cmd, cwd=cwd, capture_output=True, text=True, timeout=timeout,
+                                  check=False)
+        except OSError as exc:
+            if exc.errno != errno.ETXTBSY or attempt == 19:
+                raise
+            time.sleep(0.05 * (attempt + 1))
+    raise AssertionError("unreachable")
 
 
 def prepare(model: Path, params_dir: Path, workdir: Path, defines=(), extra_files=(), cflags=None):

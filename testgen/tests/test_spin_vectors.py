@@ -95,3 +95,27 @@ def test_verify_passes_when_the_property_holds(tmp_path):
     p = res["properties"][0]
     assert p["verdict"] == "verified" and p["errors"] == 0 and p["states_stored"] > 0
     assert res["bounds"] == {"wrap": 4, "limit": 5}
+
+
+def test_run_retries_text_file_busy_and_raises_other_errors(monkeypatch):
+    """A freshly linked ./pan can be 'text file busy' for a moment under load: retried; any
+    other OSError is not."""
+    import errno as _errno
+    calls = {"n": 0}
+    real = spin.subprocess.run
+
+    def busy_twice(*a, **k):
+        calls["n"] += 1
+        if calls["n"] < 3:
+            raise OSError(_errno.ETXTBSY, "Text file busy")
+        return real(*a, **k)
+
+    monkeypatch.setattr(spin.subprocess, "run", busy_twice)
+    assert spin._run(["true"], ".").returncode == 0 and calls["n"] == 3
+
+    def missing(*a, **k):
+        raise OSError(_errno.ENOENT, "No such file")
+
+    monkeypatch.setattr(spin.subprocess, "run", missing)
+    with pytest.raises(OSError):
+        spin._run(["true"], ".")
