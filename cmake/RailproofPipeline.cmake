@@ -7,7 +7,7 @@
 #   evidence  : test results as JUnit XML (unit, conformance, testgen), residual-error
 #               analysis, tool versions, trace.json, and the rendered evidence package
 #               in ${CMAKE_BINARY_DIR}/evidence (HTML + manifest.json with SHA-256).
-set(RAILPROOF_MODELS telegram moving_block braking readhesion)
+set(RAILPROOF_MODELS telegram moving_block braking readhesion level_crossing)
 set(RAILPROOF_VECTOR_DIR ${RAILPROOF_RESULTS_DIR}/vectors)
 set(_spin_outputs)
 set(_vector_outputs)
@@ -46,8 +46,8 @@ add_custom_command(
   COMMENT "tests: C++ unit tests -> results/tests/unit.xml" USES_TERMINAL VERBATIM)
 set(_evidence_tests ${_tests_dir}/unit.xml)
 # Conformance replays: one JUnit file per runner (railproof_conformance = telegram, _mb =
-# moving block, _br = braking decision, _ra = re-adhesion state machine).
-foreach(_conf conformance conformance_mb conformance_br conformance_ra)
+# moving block, _br = braking decision, _ra = re-adhesion state machine, _lc = level crossings).
+foreach(_conf conformance conformance_mb conformance_br conformance_ra conformance_lc)
   if(TARGET railproof_${_conf})
     add_custom_command(
       OUTPUT ${_tests_dir}/${_conf}.xml

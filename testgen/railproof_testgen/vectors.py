@@ -196,6 +196,9 @@ def generate(model: Path, params_dir: Path, spec_dir: Path, workdir: Path, out_d
     if model.stem == "readhesion":
         from . import ra_vectors
         return ra_vectors.generate(model, params_dir, spec_dir, workdir, out_dir, walks, jobs)
+    if model.stem == "level_crossing":
+        from . import lc_vectors
+        return lc_vectors.generate(model, params_dir, spec_dir, workdir, out_dir, walks, jobs)
     model_rel = f"models/{model.name}"
     ann = spin_mod.parse_annotations(model)
     if not ann.goals:

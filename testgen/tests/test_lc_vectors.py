@@ -1,0 +1,418 @@
+"""Tests of the level-crossing vectors (railproof_testgen.lc_vectors, models/level_crossing.pml,
+spec/schemas/vectors_level_crossing.schema.json). The C++ conformance runner
+(railproof_conformance_lc) is the behavioural check of the vectors; these tests check that they
+are parsed, converted to absolute times and C++ units, schema-checked, generated for every
+configuration, consistent with design note §3-§5 and cover every goal (or justify it)."""
+import copy
+import json
+import shutil
+from pathlib import Path
+
+import jsonschema
+import pytest
+import yaml
+
+from railproof_testgen import lc_vectors, spin, vectors
+from railproof_testgen.errors import PipelineError
+
+REPO = Path(__file__).resolve().parents[2]
+MODEL = REPO / "models" / "level_crossing.pml"
+SCHEMA = REPO / "spec" / "schemas" / "vectors_level_crossing.schema.json"
+needs_spin = pytest.mark.skipif(shutil.which("spin") is None or shutil.which("cc") is None,
+                                reason="spin and a C compiler are needed")
+
+# the seeded C++ faults of cpp/src/onboard/crossing.cpp, cpp/src/wayside/crossing_controller.cpp
+# and cpp/src/wayside/centre_scheduler.cpp, each mirrored by a mutant of the same name
+CPP_FAULTS = ["CLEAR_WITHOUT_WARNING_TIME", "WITHDRAW_AT_FRONT", "STALE_CONFIRMATION", "END_WITH_REQUESTER",
+              "DEPART_WITHOUT_ALL_ACKS", "LATER_UPDATE_WHILE_WARNING"]
+CONFIG_NAMES = {"ONBOARD", "LONG_WARNING", "TWO_TRAINS", "FAIR", "HEALTHY", "GNSS", "GNSS_CLOCK", "GNSS_FAIR"}
+BOUNDS = {"track": 12, "vmax": 2, "lc_a": 8, "lc_b": 10, "train_len": 1, "station": 4, "warn_ticks": 3,
+          "lower_ticks": 1, "max_delay": 1, "cycles": 30, "lead_ticks": 3, "conf_age_ticks": 0, "prot_offset": 1,
+          "dwell_ticks": 4, "gnss_dwell_ticks": 2, "holdover_ticks": 1, "response_ticks": 4, "gnss_horizon": 14,
+          "gnss_faults": 2}
+
+
+def test_annotations_of_the_level_crossing_model():
+    ann = spin.parse_annotations(MODEL)
+    props = {p.name: p for p in ann.properties}
+    assert {"REQ_LC_003_occupancy", "REQ_LC_003_fresh", "REQ_LC_007_end", "REQ_LC_007_ends", "REQ_LC_002_request",
+            "REQ_LC_006_controller", "REQ_LC_015_no_braking", "REQ_LC_009_departure", "REQ_LC_008_start",
+            "REQ_LC_013_clock", "REQ_LC_010_later"} == set(props)
+    for name, p in props.items():  # named by the requirement it verifies, in named configurations
+        assert name[:10].replace("_", "-") in p.requirements
+        assert p.configs and set(p.configs) <= CONFIG_NAMES
+    # the occupancy property holds in both variants, the liveness is a bounded response under fairness
+    assert {"ONBOARD", "GNSS"} <= set(props["REQ_LC_003_occupancy"].configs)
+    assert set(props["REQ_LC_007_ends"].configs) >= {"FAIR", "GNSS_FAIR"}
+    assert props["REQ_LC_015_no_braking"].configs == ["HEALTHY"]
+    covered = {r for p in ann.properties for r in p.requirements}
+    assert covered == {f"REQ-LC-{n:03d}" for n in range(1, 16)}
+    mutants = {m.name: m for m in ann.mutants}
+    assert {f"MUTANT_{f}" for f in CPP_FAULTS} <= set(mutants)
+    assert len(mutants) > len(CPP_FAULTS)
+    for f in CPP_FAULTS:  # each mutant names the C++ fault it mirrors
+        assert f"FAULT_LC_{f}" in mutants[f"MUTANT_{f}"].text
+    for m in ann.mutants:  # checked in one configuration where its property is verified
+        assert m.violates in props and m.config in props[m.violates].configs, m.name
+    assert len({g.number for g in ann.goals}) == len(ann.goals)
+    assert all(g.requirements and g.label for g in ann.goals)
+    assert {g.config for g in ann.goals} <= set(lc_vectors.CONFIGS)
+    assert {g.config for g in ann.goals} == set(lc_vectors.CONFIGS)  # every file gets trap vectors
+
+
+def test_model_local_bounds_are_read_from_the_model():
+    local = lc_vectors.model_local_defaults(MODEL)
+    assert set(local) | {"dwell_ticks"} == set(lc_vectors.LOCAL)
+    assert local["conf_age_ticks"] == 0 and local["lead_ticks"] >= 1 and local["gnss_faults"] >= 1
+
+
+def _model_eta2(d, v, vmax=2):
+    """The model's eta_of (half-cells d, speed v): the first whole tick the run reaches d,
+    minus a half-tick if it reaches it before."""
+    if d <= 0:
+        return 0
+    r, t, s = 0, 0, v
+    while r < d:
+        n = min(s + 1, vmax)
+        r, s, t = r + s + n, n, t + 1
+    return 2 * t - (0 if r == d else 1)
+
+
+def test_eta_classes_match_the_cpp_rounding():
+    """Every ETA the model can compute has the same class as the C++'s ms value at the chosen
+    tick length (design §2 rounding; the generator asserts the same on every vector)."""
+    for d in range(0, 2 * BOUNDS["track"] + 1):
+        for v in range(0, BOUNDS["vmax"] + 1):
+            ms = lc_vectors.eta_ms(d * lc_vectors.HALF_MM, v * lc_vectors.SPEED_MM_S, lc_vectors.ACCEL_MM_S2,
+                                   BOUNDS["vmax"] * lc_vectors.SPEED_MM_S)
+            assert lc_vectors.eta_class(ms) == _model_eta2(d, v), (d, v, ms)
+    # e.g. 4 cells from rest: accelerate 2 ticks, 2 cells at speed 2: exactly 3 ticks
+    assert lc_vectors.eta_ms(4 * lc_vectors.CELL_MM, 0, lc_vectors.ACCEL_MM_S2, 2 * lc_vectors.SPEED_MM_S) == 30_000
+    with pytest.raises(PipelineError, match="ETA class"):
+        lc_vectors.check_eta(0, 0, 0, 16, 9, BOUNDS, "test")
+
+
+ONBOARD_RUN = """spin: unrelated
+@IN tick x=0 v=0 ph=0 dw=0
+@IN bar c=0 down=0 up=1
+@IN bar c=1 down=0 up=1
+@OUT ctrl c=0 cs=0 wa=0 new=0 ack=0 rq=0
+@OUT ctrl c=1 cs=0 wa=0 new=0 ack=0 rq=0
+@IN rx c=0 age=0
+@IN rx c=1 age=0
+@OUT board s0=1 s1=1 e0=10 e1=12 lim=14
+@OUT move x=1 v=1
+@IN tick x=1 v=1 ph=0 dw=0
+@IN ul c=0 age=0 m=1
+@IN bar c=0 down=0 up=1
+@IN bar c=1 down=0 up=1
+@OUT ctrl c=0 cs=1 wa=0 new=1 ack=0 rq=1
+@OUT ctrl c=1 cs=0 wa=0 new=0 ack=0 rq=0
+@IN rx c=0 age=1
+@IN rx c=0 age=0
+@OUT board s0=1 s1=1 e0=8 e1=10 lim=14
+@OUT move x=4 v=2
+@IN tick x=4 v=2 ph=0 dw=0
+"""
+
+GNSS_RUN = """@IN tick t=0 x=8 v=0 ph=1 dw=2
+@IN pos age=0
+@OUT centre clr=0 st0=10 p0=1 a0=0 x0=0 sp0=0 sa0=0 cf0=0 st1=12 p1=1 a1=0 x1=0 sp1=0 sa1=0 cf1=0
+@IN ds c=0 age=0
+@IN clk c=0 k=0
+@IN bar c=0 down=0 up=1
+@OUT gctrl c=0 cs=0 wa=0 new=0 pres=1 pst=10 act=0 ck=0 ack=11 acc=1 sack=0
+@IN ds c=1 age=0
+@IN clk c=1 k=1
+@IN bar c=1 down=0 up=1
+@OUT gctrl c=1 cs=0 wa=0 new=0 pres=1 pst=12 act=0 ck=1 ack=13 acc=1 sack=0
+@OUT move x=8 v=0
+@IN tick t=1 x=8 v=0 ph=1 dw=1
+@IN ua c=0 age=1
+@OUT centre clr=0 st0=10 p0=0 a0=1 x0=0 sp0=0 sa0=0 cf0=0 st1=12 p1=1 a1=0 x1=0 sp1=0 sa1=0 cf1=0
+@IN clk c=0 k=0
+@IN bar c=0 down=0 up=1
+@OUT gctrl c=0 cs=0 wa=0 new=0 pres=1 pst=10 act=0 ck=0 ack=0 acc=0 sack=0
+@IN clk c=1 k=0
+@IN bar c=1 down=0 up=1
+@OUT gctrl c=1 cs=0 wa=0 new=0 pres=1 pst=12 act=0 ck=0 ack=0 acc=0 sack=0
+@OUT move x=8 v=0
+"""
+
+
+def test_parse_and_convert_onboard_ticks():
+    ticks = lc_vectors.parse_events(ONBOARD_RUN)
+    assert len(ticks) == 2  # the third tick is cut off by the end of the trail
+    assert ticks[1]["ul"] == [{"c": 0, "age": 0, "m": 1}]
+    assert ticks[1]["rx"] == [{"c": 0, "age": 1}, {"c": 0, "age": 0}]
+    steps = lc_vectors.to_steps(ticks, BOUNDS, None)
+    s0, s1 = steps
+    assert s0["t_ms"] == 0 and s1["t_ms"] == lc_vectors.TICK_MS
+    assert s0["train"] == {"front_mm": 0, "speed_mm_s": 0, "dwell": False, "departure_ms": 0}
+    assert s1["train"]["front_mm"] == 50_000 and s1["train"]["speed_mm_s"] == 10_000
+    c0 = s1["controllers"][0]
+    assert c0["in"] == {"requests": [1], "withdrawals": [], "barrier_down": False, "barrier_up": True}
+    assert c0["out"]["state"] == "WARNING" and c0["out"]["warning_start_ms"] == 10_000
+    assert c0["out"]["report"] == {"crossing_id": 1, "status": "WARNING", "warning_start_ms": 10_000,
+                                   "issued_ms": 10_000, "clock_fault": False}
+    assert c0["out"]["requesters"] == [1] and c0["out"]["lights_on"] and not c0["out"]["barriers_down_commanded"]
+    # the on-board unit receives tick 0's delayed report (age 1), then tick 1's, in that order
+    reps = s1["onboard"]["in"]["reports"]
+    assert [(r["status"], r["issued_ms"]) for r in reps] == [("OPEN", 0), ("WARNING", 10_000)]
+    out = s0["onboard"]["out"]
+    assert out["states"] == ["REQUESTED", "REQUESTED"] and out["eta_half_ticks"] == [10, 12]
+    assert out["requests"] == [1, 2] and out["withdrawals"] == [] and out["stop_limit_mm"] == 14 * 50_000
+    assert lc_vectors.observed_requirements(steps) >= {"REQ-LC-001", "REQ-LC-002", "REQ-LC-003", "REQ-LC-006"}
+
+
+def test_parse_and_convert_gnss_ticks():
+    steps = lc_vectors.to_steps(lc_vectors.parse_events(GNSS_RUN), BOUNDS, "GNSS")
+    s0, s1 = steps
+    t = lc_vectors.timing(BOUNDS, "GNSS")
+    assert t["OFS"] == 6
+    ce = s0["centre"]
+    # the standing train's report: front and rear on whole cells, speed bound 0 at the station
+    assert ce["in"]["position"] == {"train_id": 1, "time_ms": 0, "front_mm": 400_000, "rear_mm": 300_000,
+                                    "speed_mm_s": 0}
+    # initial start times: t_dep (2 ticks) + ETA from rest (3 and 4 ticks) - W (3 ticks)
+    assert [x["start_ms"] for x in ce["out"]["crossings"]] == [20_000, 30_000]
+    assert ce["out"]["start_times"] == [{"crossing_id": 1, "departure_id": 1, "start_ms": 20_000},
+                                        {"crossing_id": 2, "departure_id": 1, "start_ms": 30_000}]
+    assert ce["out"]["block"] == "MISSING_ACK" and not ce["out"]["departure_cleared"]
+    c0 = s0["controllers"][0]
+    assert c0["in"]["start_times"] == [{"crossing_id": 1, "departure_id": 1, "start_ms": 20_000}]
+    assert c0["out"]["start_acks"] == [{"crossing_id": 1, "departure_id": 1, "start_ms": 20_000, "stored": True}]
+    assert c0["out"]["pending"] == {"present": True, "departure_id": 1, "start_ms": 20_000, "active": False}
+    assert s0["controllers"][1]["in"]["clock"] == "NO_GNSS" and s0["controllers"][1]["out"]["clock"] == "HOLDOVER"
+    # tick 1: the centre receives controller A's telegram of tick 0 (ack, report)
+    assert s1["centre"]["in"]["start_acks"] == c0["out"]["start_acks"]
+    assert s1["centre"]["in"]["reports"] == [c0["out"]["report"]]
+    assert s1["centre"]["in"]["position"] is None
+    assert s1["centre"]["out"]["start_times"] == [{"crossing_id": 2, "departure_id": 1, "start_ms": 30_000}]
+
+
+def test_malformed_model_output_is_an_error():
+    with pytest.raises(PipelineError, match="unrecognised"):
+        lc_vectors.parse_events("@OUT level=1 appr=0 latched=0")
+    with pytest.raises(PipelineError, match="outside a tick"):
+        lc_vectors.parse_events("@OUT ctrl c=0 cs=0 wa=0 new=0 ack=0 rq=0")
+    bad = ONBOARD_RUN.replace("@OUT ctrl c=0 cs=1 wa=0 new=1 ack=0 rq=1", "@OUT ctrl c=0 cs=1 wa=0 new=1 ack=0 rq=0")
+    with pytest.raises(PipelineError, match="requester tracking"):
+        lc_vectors.to_steps(lc_vectors.parse_events(bad), BOUNDS, None)
+    bad = ONBOARD_RUN.replace("e0=8 e1=10", "e0=7 e1=10")
+    with pytest.raises(PipelineError, match="ETA class"):
+        lc_vectors.to_steps(lc_vectors.parse_events(bad), BOUNDS, None)
+    bad = GNSS_RUN.replace("@OUT centre clr=0 st0=10 p0=0 a0=1", "@OUT centre clr=1 st0=10 p0=0 a0=1")
+    with pytest.raises(PipelineError, match="departure signal"):
+        lc_vectors.to_steps(lc_vectors.parse_events(bad), BOUNDS, "GNSS")
+
+
+def _header(config=None):
+    h = lc_vectors.header_for(MODEL, BOUNDS, config)
+    h["spin_version"] = "test"
+    return h
+
+
+def test_header_records_the_configuration_and_units():
+    h, hl, hg = _header(), _header("LONG_WARNING"), _header("GNSS")
+    assert h["configuration"] == "default" and h["variant"] == "ONBOARD" and hg["variant"] == "GNSS"
+    p = h["parameters"]
+    assert [c["warning_time_ms"] for c in p["crossings"]] == [30_000, 30_000]
+    assert [c["warning_time_ms"] for c in hl["parameters"]["crossings"]] == [40_000, 40_000]
+    assert p["crossings"][0]["near_mm"] == 800_000 and p["crossings"][0]["far_mm"] == 900_000
+    assert p["protection"]["request_lead_ms"] == 30_000 and p["protection"]["confirmation_max_age_ms"] == 0
+    assert p["controller"]["barrier_timeout_ms"] == 20_000 and hl["parameters"]["controller"]["barrier_timeout_ms"] == 30_000
+    assert p["restrictions"] == [{"begin_mm": 0, "end_mm": 1_400_000, "limit_mm_s": 20_000}]
+    assert "departure" not in p and hg["parameters"]["departure"]["departure_ms"] == 20_000
+    assert h["unit_scales"]["mm_s2_per_accel_unit"] == 1000 and h["units"] == lc_vectors.UNITS
+
+
+def _vector(config=None, run=ONBOARD_RUN, vid="LC-TRAP-G0"):
+    steps = lc_vectors.to_steps(lc_vectors.parse_events(run), BOUNDS, config)
+    return {"id": vid, "requirements": ["REQ-LC-002"], "goal": "G0", "kind": "trap", "seed": None, "steps": steps}
+
+
+def test_schema_accepts_good_and_rejects_bad_records():
+    good = [_header(), _vector()]
+    text = vectors.schema_checked_jsonl(SCHEMA, good, "level_crossing.jsonl")
+    assert [json.loads(ln) for ln in text.splitlines()] == good
+    vectors.schema_checked_jsonl(SCHEMA, [_header("GNSS"), _vector("GNSS", GNSS_RUN, "LC-TRAP-GNSS-G60")],
+                                 "level_crossing.gnss.jsonl")
+
+    def broken(edit):
+        lines = copy.deepcopy(good)
+        edit(lines)
+        return lines
+
+    cases = {
+        "units": lambda ls: ls[0].update(units="ticks"),
+        "tick length": lambda ls: ls[0]["unit_scales"].update(ms_per_tick=1000),
+        "unknown configuration": lambda ls: ls[0].update(configuration="THREE_TRAINS"),
+        "GNSS parameters in an ONBOARD file": lambda ls: ls[0]["parameters"].update(scheduler={"clock_allowance_ms": 0}),
+        "GNSS variant without departure": lambda ls: ls[0].update(variant="GNSS", configuration="GNSS"),
+        "crossing missing": lambda ls: ls[0]["parameters"]["crossings"].pop(),
+        "bad vector id": lambda ls: ls[1].update(id="RA-TRAP-G0"),
+        "requirement of another area": lambda ls: ls[1].update(requirements=["REQ-RA-003"]),
+        "unknown controller state": lambda ls: ls[1]["steps"][0]["controllers"][0]["out"].update(state="LOWERING"),
+        "unknown on-board state": lambda ls: ls[1]["steps"][0]["onboard"]["out"].update(states=["GO", "GO"]),
+        "report status": lambda ls: ls[1]["steps"][1]["onboard"]["in"]["reports"][0].update(status="OPENING"),
+        "output field missing": lambda ls: ls[1]["steps"][0]["onboard"]["out"].pop("stop_limit_mm"),
+        "extra input": lambda ls: ls[1]["steps"][0]["train"].update(accel=1),
+        "one controller": lambda ls: ls[1]["steps"][0]["controllers"].pop(),
+        "no steps": lambda ls: ls[1].update(steps=[]),
+    }
+    for what, edit in cases.items():
+        with pytest.raises(PipelineError, match="violates the vector schema"):
+            vectors.schema_checked_jsonl(SCHEMA, broken(edit), "level_crossing.jsonl")
+            pytest.fail(f"schema accepted: {what}")
+
+
+FILES = ["level_crossing.jsonl", "level_crossing.long_warning.jsonl", "level_crossing.two_trains.jsonl",
+         "level_crossing.gnss.jsonl", "level_crossing.gnss_clock.jsonl"]
+
+
+@pytest.fixture(scope="module")
+def generated(tmp_path_factory):
+    if shutil.which("spin") is None or shutil.which("cc") is None:
+        pytest.skip("spin and a C compiler are needed")
+    tmp = tmp_path_factory.mktemp("lc")
+    params = tmp / "params"
+    params.mkdir()
+    # the model bounds of spec/parameters/level_crossing.yaml, as gen-params writes them
+    data = yaml.safe_load((REPO / "spec" / "parameters" / "level_crossing.yaml").read_text(encoding="utf-8"))
+    (params / "level_crossing_params.pml").write_text(
+        "".join(f"#define {e['id'].upper()} {e['value']}\n" for e in data["model_bounds"]), encoding="utf-8")
+    out = tmp / "vectors"
+    out.mkdir()
+    (out / "level_crossing.stale.jsonl").write_text("{}\n", encoding="utf-8")  # an earlier run's file
+    cov = vectors.generate(MODEL, params, REPO / "spec", tmp / "work", out, walks=5, jobs=2)
+    files = {name: [json.loads(ln) for ln in (out / name).read_text(encoding="utf-8").splitlines()] for name in FILES}
+    b = lc_vectors.all_bounds(MODEL, params / "level_crossing_params.pml")
+    return cov, files, out, b
+
+
+@needs_spin
+def test_vectors_are_schema_valid_and_cover_every_goal(generated):
+    cov, files, out, _b = generated
+    assert sorted(p.name for p in out.glob("*.jsonl")) == sorted(FILES)
+    validator = jsonschema.Draft202012Validator(json.loads(SCHEMA.read_text(encoding="utf-8")))
+    ids = set()
+    for name, lines in files.items():
+        for n, obj in enumerate(lines, 1):
+            assert not list(validator.iter_errors(obj)), f"{name} line {n}"
+        header = lines[0]
+        assert header["model"] == "models/level_crossing.pml" and header["model_sha256"] == spin.sha256_file(MODEL)
+        cfg = next(c for c, v in lc_vectors.CONFIGS.items() if f"level_crossing{v[0]}.jsonl" == name)
+        assert header["configuration"] == (cfg or "default")
+        assert len(lines) > 1
+        for v in lines[1:]:
+            assert v["id"] not in ids
+            ids.add(v["id"])
+            assert v["id"].startswith(f"LC-{v['kind'].upper()}-{lc_vectors.CONFIGS[cfg][1]}")
+    ann = spin.parse_annotations(MODEL)
+    assert cov["labelled"] == len(ann.goals)
+    jfile = REPO / "spec" / "justifications" / "level_crossing.yaml"
+    justified = {}
+    if jfile.exists():
+        justified = {j["goal"]: j["id"] for j in yaml.safe_load(jfile.read_text())["justifications"]}
+    for g in cov["goals"]:  # reached with a vector, or justified
+        if g["status"] == "reached":
+            assert g["vectors"] and set(g["vectors"]) <= ids
+        else:
+            assert g["justification"] == justified[g["id"]], g
+    assert cov["reached"] + cov["unreachable_justified"] == len(ann.goals)
+    assert sum(v["kind"] == "random" for v in files["level_crossing.jsonl"][1:]) == 5
+    assert cov["files"] == {n: len(lines) - 1 for n, lines in files.items()}
+    on_disk = json.loads((out / "level_crossing.coverage.json").read_text(encoding="utf-8"))
+    assert on_disk["reached"] == cov["reached"]
+
+
+@needs_spin
+def test_vectors_follow_the_design_note(generated):
+    """Invariants of design note §3-§5 on every step of every vector (the exact values are the
+    C++ conformance runner's check)."""
+    _cov, files, _out, b = generated
+    for name, lines in files.items():
+        h = lines[0]["parameters"]
+        near = {c["id"]: c["near_mm"] for c in h["crossings"]}
+        offset = h["protection"]["protection_offset_mm"]
+        for v in lines[1:]:
+            prev_t = -1
+            for s in v["steps"]:
+                assert s["t_ms"] == prev_t + 10_000 or (prev_t < 0 and s["t_ms"] == 0)
+                prev_t = s["t_ms"]
+                for c in s["controllers"]:
+                    o = c["out"]
+                    assert o["report"]["status"] == lc_vectors.STATUS_OF[o["state"]]
+                    assert o["report"]["issued_ms"] == s["t_ms"]
+                    assert o["lights_on"] == (o["state"] != "OPEN")
+                    assert (o["failure"] != "NONE") == (o["state"] == "FAILED")
+                    if o["state"] == "CLOSED":  # REQ-LC-006: closed only while detected down
+                        assert c["in"]["barrier_down"] and not c["in"]["barrier_up"]
+                if "onboard" in s:
+                    o = s["onboard"]["out"]
+                    # REQ-LC-002/-004: requests for REQUESTED/CLEARED, withdrawals for PASSED
+                    assert o["requests"] == [cid for cid, st in zip((1, 2), o["states"]) if st in ("REQUESTED", "CLEARED")]
+                    assert o["withdrawals"] == [cid for cid, st in zip((1, 2), o["states"]) if st == "PASSED"]
+                    # REQ-LC-003: the most restrictive limit of the crossings not cleared
+                    limits = [near[cid] - offset for cid, st in zip((1, 2), o["states"])
+                              if st in ("APPROACHING", "REQUESTED")]
+                    assert o["stop_limit_mm"] == (min(limits) if limits else None)
+                    # REQ-LC-004: a withdrawal only once the rear has passed the far edge
+                    for cid, st in zip((1, 2), o["states"]):
+                        if st == "PASSED":
+                            far = next(c["far_mm"] for c in h["crossings"] if c["id"] == cid)
+                            assert s["train"]["front_mm"] - h["train"]["length_mm"] >= far
+                    for r in s["onboard"]["in"]["reports"]:  # reports come from the past
+                        assert r["issued_ms"] <= s["t_ms"]
+                else:
+                    o = s["centre"]["out"]
+                    # REQ-LC-009: the departure signal only with every acknowledgement, no fault, t_dep
+                    assert o["departure_cleared"] == (all(c["acked"] for c in o["crossings"]) and
+                                                      not any(c["clock_fault"] for c in o["crossings"]) and
+                                                      s["t_ms"] >= h["departure"]["departure_ms"])
+                    pos = s["centre"]["in"]["position"]
+                    if pos is not None:
+                        assert pos["time_ms"] <= s["t_ms"] and pos["rear_mm"] < pos["front_mm"]
+
+
+@needs_spin
+def test_boundary_vectors_hit_the_boundaries(generated):
+    _cov, files, _out, b = generated
+    t = lc_vectors.timing(b, None)
+    vecs = {v["goal"]: v for v in files["level_crossing.jsonl"][1:] if v["goal"]}
+    last = {g: v["steps"][-1] for g, v in vecs.items()}
+    # G0/G1: the request exactly at ETA = W + LEAD, none half a tick above
+    assert last["G0"]["onboard"]["out"]["states"][0] == "REQUESTED"
+    assert last["G0"]["onboard"]["out"]["eta_half_ticks"][0] == 2 * (t["W"] + t["LEAD"])
+    assert last["G1"]["onboard"]["out"]["states"][0] == "APPROACHING"
+    assert last["G1"]["onboard"]["out"]["eta_half_ticks"][0] == 2 * (t["W"] + t["LEAD"]) + 1
+    # G2: requested in the dwell, the remaining dwell counted
+    s = last["G2"]
+    assert s["train"]["dwell"] and s["train"]["departure_ms"] > s["t_ms"]
+    assert s["onboard"]["out"]["eta_half_ticks"][0] == 2 * (t["W"] + t["LEAD"])
+    # G5: a CLOSED report one tick older than the confirmation age does not clear
+    s = last["G5"]
+    assert [r["status"] for r in s["onboard"]["in"]["reports"]] == ["CLOSED"]
+    assert s["onboard"]["in"]["reports"][0]["issued_ms"] == s["t_ms"] - 10_000
+    assert s["onboard"]["out"]["states"][0] == "REQUESTED"
+    # G10: stuck barrier: FAILED exactly at ws + LOWER + TO
+    c = last["G10"]["controllers"][0]["out"]
+    assert c["state"] == "FAILED" and c["failure"] == "BARRIER_NOT_DOWN"
+    assert last["G10"]["t_ms"] - c["warning_start_ms"] == (t["LOWER"] + t["TO"]) * 10_000
+    # G17: the rear exactly at the far edge: PASSED and withdrawn
+    s = last["G17"]
+    assert s["onboard"]["out"]["states"][0] == "PASSED" and s["onboard"]["out"]["withdrawals"] == [1]
+    assert s["train"]["front_mm"] - 100_000 == 900_000
+    # LONG_WARNING G4: CLOSED for the train but warned too short: no clearance
+    lw = {v["goal"]: v for v in files["level_crossing.long_warning.jsonl"][1:] if v["goal"]}
+    s = lw["G4"]["steps"][-1]
+    assert s["onboard"]["out"]["states"][0] == "REQUESTED"
+    assert any(r["status"] == "CLOSED" for r in s["onboard"]["in"]["reports"])
+    # GNSS G60: autonomous start exactly at the stored start time
+    gv = {v["goal"]: v for v in files["level_crossing.gnss.jsonl"][1:] if v["goal"]}
+    s = gv["G60"]["steps"][-1]["controllers"][0]
+    assert s["out"]["state"] == "WARNING" and s["out"]["pending"]["start_ms"] == gv["G60"]["steps"][-1]["t_ms"]
+    # GNSS G100: the train leaves exactly at t_dep on the signal
+    s = gv["G100"]["steps"][-1]
+    assert s["centre"]["out"]["departure_cleared"] and s["t_ms"] == 2 * 10_000
