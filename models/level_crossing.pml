@@ -8,76 +8,95 @@
  *
  * What is modelled. A line of track cells 0..MODEL_TRACK (one cell = the distance run in one
  * tick at speed 1), one train of MODEL_TRAIN_LEN cells, a station stop at MODEL_STATION and
- * two crossings, each one cell wide, at MODEL_LC_A and MODEL_LC_B beyond it. One tick is one
- * cycle of every unit (on-board, crossing controllers, centre), all at the same time `now`.
+ * two crossings A and B, each one cell wide, at MODEL_LC_A and MODEL_LC_B beyond it. One tick
+ * is one cycle of every unit (on-board, crossing controllers, centre), all at the same `now`.
  *
- * Train. Positions are kept in half-cells and the train's speed is 0..MODEL_VMAX cells per
- * tick, changing by at most 1 per tick (acceleration and braking 1 cell/tick²); in a tick it
- * runs (v + v') / 2 cells, the exact distance of a constant acceleration, so that its motion
- * is that of a real train with these limits and the C++ earliest-arrival computation (design
- * §2, continuous) is exact for it. The ETA is kept as a number of half-ticks eta2 = 2 floor(E)
- * + (E not an integer): every comparison of the design with a whole number of ticks n is
- * exact on it (E <= n iff eta2 <= 2n, E >= n iff eta2 >= 2n), and so is the C++'s rounded
- * ms value (the vector generator checks the tick length against the fractions that occur).
- * The train stops at the station (it never chooses a speed from which it cannot stop there),
- * dwells at least DWELL ticks (ONBOARD: its departure is not authorised earlier; GNSS: the
- * planned departure time and the departure signal), may stand anywhere for as long as it
- * likes, and stops at the end of the track. It brakes on the protection pattern: it never
- * chooses a speed from which it cannot stop before the most restrictive protection limit
- * (the braking module's guarantee, REQ-BR-001, ASM-030); if no speed is left (a clearance
- * revoked too late), it brakes as hard as it can. The position envelope has no error
- * (front_max = front, rear_min = front - length: the odometry's envelope is REQ-RA-012's).
+ * Train. Positions are kept in half-cells and the speed is 0..MODEL_VMAX cells per tick,
+ * changing by at most 1 per tick (acceleration and braking 1 cell/tick²); in a tick the train
+ * runs (v + v') / 2 cells, the exact distance under a constant acceleration, so its motion is
+ * that of a real train with these limits and the continuous earliest-arrival computation of
+ * design §2 is exact for it. An ETA is kept as eta2 = 2 floor(E) + (E not whole), E in ticks:
+ * every comparison of the design with a whole number of ticks n is exact on it (E <= n iff
+ * eta2 <= 2n, E >= n iff eta2 >= 2n), and so is the C++'s ms value rounded down (the vector
+ * generator checks the tick length against every fraction that occurs). The train stops at
+ * the station (it never chooses a speed from which it cannot stop there) and dwells there
+ * (ONBOARD: its departure is not authorised before t_dep = arrival + DWELL; GNSS: it leaves
+ * on the departure signal), may stand anywhere as long as it likes and stops at the end of
+ * the track. It brakes on the protection pattern: it never chooses a speed from which it
+ * cannot stop before the most restrictive protection limit (the braking module's guarantee,
+ * REQ-BR-001, ASM-030); if none is left (a clearance revoked too late) it brakes as hard as it
+ * can. The position envelope has no error (front_max = front, rear_min = front - length).
+ * The train occupies a crossing from front >= near until rear >= far; the properties check
+ * the crossing's state during every tick the train occupies it or enters it.
  *
- * ONBOARD configuration (default; design §3, §4). The on-board crossing function per
- * crossing (APPROACHING, REQUESTED, CLEARED, PASSED, DONE: passage, request at
- * ETA <= W + LEAD, clearance on a fresh CLOSED report with ws + W <= now + ETA, revocation on
- * a report that is not CLOSED, protection limit near - PO for APPROACHING and REQUESTED,
- * withdrawal until acknowledged) and one controller per crossing (OPEN, WARNING, CLOSING,
- * CLOSED, OPENING, FAILED; the order of CrossingController::Cycle). The radio: every
- * telegram (request / withdrawal per crossing train -> ground; report with the withdrawal
- * acknowledgement per crossing ground -> train, every cycle) is delivered in its tick, one
- * tick late (delay 0..MODEL_MAX_DELAY) or lost; telegrams of one link arrive in order (the
- * telegram layer, REQ-TG-004). A train -> ground telegram of tick k reaches the controllers'
- * cycle of tick k (delay 0) or k + 1; a report of the controllers' cycle of tick k reaches
- * the on-board cycle of tick k + 1 (age 1 tick) or k + 2 (age 2). The barriers, detected down
+ * ONBOARD configuration (the default; design §3, §4). Per crossing the on-board function
+ * (APPROACHING, REQUESTED, CLEARED, PASSED, DONE, in the order of CrossingProtection::Cycle:
+ * passage, request at ETA <= W + LEAD (a train standing in its dwell: the remaining dwell plus
+ * the run from rest), clearance on a report of the cycle (age <= CMA) that is CLOSED, lists the
+ * train among the requesters and has ws + W <= now + ETA, revocation on any other report,
+ * protection limit near - PO for APPROACHING and REQUESTED, withdrawal until acknowledged)
+ * and a controller (OPEN, WARNING, CLOSING, CLOSED, OPENING, FAILED, in the order of
+ * CrossingController::Cycle). A tick runs the controllers' cycles, then the on-board cycle.
+ * The radio: every telegram (request or withdrawal per crossing, train -> ground; the report
+ * with the withdrawal acknowledgement per crossing, ground -> train, every cycle) arrives in
+ * its tick, one tick late (delay MODEL_MAX_DELAY) or is lost; the telegrams of a link arrive
+ * in order (the telegram layer, REQ-TG-004). A train telegram of tick k reaches the
+ * controllers' cycle of tick k + 1 or k + 2; a report of the controllers' cycle of tick k
+ * reaches the on-board cycle of tick k (age 0) or k + 1 (age 1). The barriers, detected down
  * or up every cycle, may never come down (stuck up), lose their down detection while closed,
- * or never rise again (stuck down). A second train (OTHER, crossing A only: another track)
- * requests and withdraws at any time, so that a controller holds two requesters.
+ * or never rise again (stuck down).
+ *
+ * The requester list. The report names the trains among the controller's requesters, and the
+ * train is cleared only by a CLOSED report that names it (and revoked by one that does not):
+ * design §3 item 3, CrossingReport::requesters. The earlier rule (any CLOSED report clears)
+ * lets a train whose requests are lost or late be cleared by a warning held for another
+ * train, which ends when that train withdraws while the first one runs onto the crossing
+ * (mutant MUTANT_CLEAR_ON_ANY_CLOSED, rejected by REQ_LC_003_occupancy in TWO_TRAINS).
  *
  * GNSS configuration (design §5). The centre (StartDeparture at time 0 with t_dep = GDWELL,
- * start times, acknowledgements, departure signal, recomputation from position reports,
- * warning stop after the passage report), both controllers (stored start time, autonomous
- * start, earlier / later updates, warning stop, clock: synchronised, holdover, faulty) and
- * the train, which leaves the station only on the departure signal and has no protection
- * pattern (low-cost lines). Every centre <-> controller telegram and every position report
- * is delivered in its tick, one tick late or lost; on these links only the newest message
- * due in a cycle is delivered (an older delayed one due in the same cycle is discarded, as
+ * start times re-sent until acknowledged, the departure signal, recomputation from position
+ * reports, the warning stop after the passage report), both controllers (stored start time,
+ * autonomous start, earlier / later updates, warning stop, clock) and the train, which leaves
+ * the station on the departure signal and has no protection pattern (low-cost lines). A tick
+ * runs the centre's cycle, then the controllers'. Every centre <-> controller telegram and
+ * every position report arrives in its tick, one tick late or is lost; on these links only
+ * the newest telegram due in a cycle is delivered (an older one due with it is discarded, as
  * if lost). Position reports carry the time they were taken, the front rounded up and the
  * rear rounded down to whole cells (an envelope) and as speed bound 0 while standing at the
- * station before the departure and MODEL_VMAX once departed (the bound over the report's
- * lifetime): every start time is then a whole number of half-ticks and kept exactly. The
- * GNSS configuration keeps absolute time (the stored start times are compared with each
- * other), so its search covers every run of up to GNSS_HORIZON ticks (every run in which the
- * train, once its signal clears, passes both crossings, plus any waiting before).
+ * station and MODEL_VMAX once departed (the bound over the report's lifetime): every start
+ * time is then a whole number of half-ticks, kept exactly. The GNSS configurations keep
+ * absolute time (start times are compared with each other) and bound the environment: the
+ * search covers every run of up to GNSS_HORIZON ticks with up to GNSS_FAULTS telegram losses
+ * or delays, clock faults and GNSS outages (an outage counts once, however long); every run in
+ * which the train leaves and passes both crossings fits in the horizon.
  *
- * Further configurations (-D): FAIR = ONBOARD with a working crossing (no barrier fault, the
- * barriers come down and up within the timeout), no second train and a fair radio (a link
- * never loses two telegrams in a row): the bounded-response property of the warning's end;
- * HEALTHY = ONBOARD with a working crossing, no second train, no loss and the reports within
- * the confirmation age (REQ-LC-015); GNSS_FAIR = GNSS with FAIR's fairness; WALK stops after
- * MODEL_CYCLES ticks (random-walk vectors); TRAPS adds the goal flags.
+ * Configurations (-D; each property names those it is verified in): ONBOARD (= default);
+ * LONG_WARNING = ONBOARD with crossings whose design warning time is one tick longer (with
+ * W = MODEL_WARN_TICKS, MODEL_LOWER_TICKS = 1 and the protection offset, the first CLOSED
+ * report can only reach a train that is at least W - LOWER - 1 ticks away, so the clearance's
+ * warning-time condition never decides: LONG_WARNING makes it decide); TWO_TRAINS = ONBOARD
+ * with a second train (another track) requesting and withdrawing crossing A at any time,
+ * working barriers; FAIR = ONBOARD with working barriers (down and up within the timeout), no
+ * second train and a fair radio (a link never loses two telegrams in a row): the bounded
+ * response of the warning's end; HEALTHY = ONBOARD with prompt barriers, no loss and reports
+ * within the confirmation age (REQ-LC-015); GNSS (losses, delays, barrier faults); GNSS_CLOCK
+ * (GNSS outages, holdover and clock faults, losses, working barriers); GNSS_FAIR (GNSS with
+ * FAIR's radio and barriers); WALK stops after MODEL_CYCLES ticks (random walks); TRAPS adds
+ * the goal flags.
  *
  * Timing (ticks; spec/parameters/level_crossing.yaml model_bounds and the model-local bounds
  * below): W = MODEL_WARN_TICKS design warning time, LOWER = MODEL_LOWER_TICKS barrier
- * lowering, TO = W - LOWER barrier timeout (so a crossing is CLOSED or FAILED when the
- * warning time is over, ASM-029: 8 s + 15 s <= 30 s), LEAD request lead, CMA confirmation
- * age (1: only a report of the previous cycle clears), PO protection offset (cells).
+ * lowering, TO = W - LOWER barrier timeout (a crossing is CLOSED or FAILED once the warning
+ * time is over, as ASM-029's 8 s + 15 s <= 30 s), LEAD request lead (the smallest that keeps
+ * REQ_LC_015), CMA = 0 confirmation age (a report of the on-board cycle's own tick), PO
+ * protection offset (cells), RESP bounded response (the smallest that keeps REQ_LC_007_ends).
  *
- * Properties are evaluated by check() after every tick on the state before it, the inputs,
- * the outputs and the state after it, into latched ghost bits v_*; each LTL property says one
- * of them never becomes 1. Inputs, outputs and scratch values are cleared at the end of the
- * tick. The ONBOARD configurations keep times relative (warning age, timers) and are
- * exhaustive over unbounded runs.
+ * Properties are evaluated in the cycles and after every tick on the state before it, the
+ * inputs, the outputs and the state after it, into latched ghost bits v_*; each LTL property
+ * says one of them never becomes 1. Inputs, outputs and scratch values are cleared as soon as
+ * they are consumed, every nondeterministic choice is one transition (the breadth-first
+ * search stores the states inside the atomic tick). The ONBOARD configurations keep times
+ * relative (warning age, timers) and are exhaustive over unbounded runs.
  *
  * Annotations read by testgen: see models/telegram.pml.
  */
@@ -147,7 +166,8 @@
 #define MODEL_RESPONSE_TICKS 4  /* bounded response: the smallest that satisfies REQ_LC_007_ends */
 #endif
 #ifndef MODEL_GNSS_FAULTS
-#define MODEL_GNSS_FAULTS 2     /* GNSS: telegram losses, delays and clock events per run */
+#define MODEL_GNSS_FAULTS 2     /* GNSS: telegram losses and delays, clock faults and outages
+                                   (an outage counts once, however long) per run */
 #endif
 #ifndef MODEL_GNSS_HORIZON
 #define MODEL_GNSS_HORIZON 14   /* GNSS: ticks covered by the (absolute-time) search */
@@ -313,7 +333,7 @@ byte ncycles;
 
 /* ---- transients (cleared when consumed, at the latest at the end of the tick) --------------- */
 byte eta[2];                   /* ETA of the cycle (half-ticks), APPROACHING..CLEARED */
-byte r2[2], r1[2];             /* reports delivered to the on-board: age 2, age 1 (status + 1) */
+byte r2[2], r1[2];             /* reports delivered to the on-board: age 1, age 0 (status + 1) */
 bit r2r[2], r1r[2], r2a[2], r1a[2];  /* their requester bit and acknowledgement */
 byte u1[2], u0[2];             /* train -> ground telegrams delivered: last tick's, this tick's */
 bit rin[2];                    /* a request of the train arrived at the controller */
@@ -842,8 +862,8 @@ inline check() {
 }
 
 inline goals_crossing(i, k) {
-  ON(was_ob[i] == O_APP && ob[i] != O_APP && eta[i] == 2 * (W + LEAD) && was_ph != P_DWELL, k + 0);
-  ON(was_ob[i] == O_APP && ob[i] == O_APP && eta[i] == 2 * (W + LEAD) + 1, k + 1);
+  ON(was_ob[i] == O_APP && ob[i] != O_APP && eta[i] == 2 * (W + LEAD), k + 0);
+  ON(was_ob[i] == O_APP && ob[i] == O_APP && eta[i] == 2 * (W + LEAD) + 2, k + 1);
   ON(was_ob[i] == O_APP && ob[i] != O_APP && eta[i] == 2 * (W + LEAD) && was_ph == P_DWELL && was_dw > 0, k + 2);
   ON(was_ob[i] == O_CLR && ob[i] == O_PAS && was_x == FAR(i) + L2, k + 17);
   ON(ob[i] == O_CLR && was_x < FAR(i) + L2 && was_x >= FAR(i), k + 18);
@@ -1100,7 +1120,8 @@ inline posrep() {
 #define PICK_CLOCK(i) \
   if \
   :: kin[i] = K_GNSS \
-  :: d_step { ck[i] != KS_FAULTY && nf < NFB -> kin[i] = K_NOGNSS; nf++ } \
+  :: d_step { ck[i] == KS_SYNC && nf < NFB -> kin[i] = K_NOGNSS; nf++ } \
+  :: d_step { ck[i] == KS_HOLD -> kin[i] = K_NOGNSS } \
   :: d_step { ck[i] != KS_FAULTY && nf < NFB -> kin[i] = K_FAULT; nf++ } \
   fi
 #else
@@ -1211,9 +1232,7 @@ inline goals() {
   ON(now >= GDWELL && !clr && cack[0] && cack[1] && (ccf[0] || ccf[1]), 92);
   ON(cpass[0] && !was_cpass, 93);
   ON(REAR_PASSED(0) && !cpass[0] && WARNING(cs[0]), 94);
-  ON(pres[1] && cpend[1] && cst[1] > pst[1] && !WARNING(cs[1]), 95);
-  ON(px != 0 && pt < now && !pstd, 96);
-  ON(px != 0 && pstd && pt > GDWELL && cpend[1] && cst[1] > ist[1], 97);
+  ON(pres[1] && cpend[1] && cst[1] > pst[1], 95);
   ON(ua_late && cack[0] && cack[1], 98);
   ON(WARNING(cs[0]) && WARNING(cs[1]) && cs[0] != C_FAILED && cs[1] != C_FAILED, 99);
   ON(was_ph == P_DWELL && ph == P_GONE && now == GDWELL, 100)
@@ -1266,6 +1285,8 @@ end:
        d_step {
          uplink_g(1);
          centre();
+         ON(px != 0 && pt < now && !pstd, 96);
+         ON(px != 0 && pstd && pt > GDWELL && cpend[1] && cst[1] > ist[1], 97);
          printf("@OUT centre clr=%d st0=%d p0=%d a0=%d x0=%d sp0=%d sa0=%d cf0=%d st1=%d p1=%d a1=%d x1=%d sp1=%d sa1=%d cf1=%d\n",
                 clr, cst[0], cpend[0], cack[0], cpass[0], spend[0], sack[0], ccf[0],
                 cst[1], cpend[1], cack[1], cpass[1], spend[1], sack[1], ccf[1]);
@@ -1309,7 +1330,7 @@ end:
 
 // @property REQ_LC_003_occupancy REQ-LC-003 REQ-LC-006 REQ-LC-011 REQ-LC-014 : the train never occupies a crossing (front at or beyond the near edge, rear before the far edge, also inside a tick) unless it has warned for at least MODEL_WARN_TICKS at the train's arrival and is CLOSED; ONBOARD: or its barriers lost their down detection while the train was cleared (a detected failure under a cleared train); GNSS: or it FAILED (no train-side protection: the lights keep warning) [config ONBOARD LONG_WARNING TWO_TRAINS FAIR HEALTHY GNSS GNSS_CLOCK]
 ltl REQ_LC_003_occupancy { [] !v_occ }
-// @property REQ_LC_003_fresh REQ-LC-003 REQ-LC-001 : the on-board unit clears a crossing only on the controller's state of the previous cycle (the only report within the confirmation age) being CLOSED with the train among its requesters and a warning start at least MODEL_WARN_TICKS before the train's earliest arrival [config ONBOARD LONG_WARNING TWO_TRAINS FAIR HEALTHY]
+// @property REQ_LC_003_fresh REQ-LC-003 REQ-LC-001 : the on-board unit clears a crossing only on the controller's state of the same cycle (the only report within the confirmation age) being CLOSED with the train among its requesters and a warning start at least MODEL_WARN_TICKS before the train's earliest arrival [config ONBOARD LONG_WARNING TWO_TRAINS FAIR HEALTHY]
 ltl REQ_LC_003_fresh { [] !v_fresh }
 // @property REQ_LC_007_end REQ-LC-004 REQ-LC-007 REQ-LC-012 : a withdrawal (ONBOARD) or warning stop (GNSS) is sent only after the train's rear has passed the crossing's far edge, and a warning ends (CLOSED to OPENING) only when no requester is left and the train that needed it has passed with its rear [config ONBOARD LONG_WARNING TWO_TRAINS FAIR HEALTHY GNSS GNSS_CLOCK]
 ltl REQ_LC_007_end { [] !v_end }
@@ -1337,7 +1358,7 @@ ltl REQ_LC_010_later { [] !v_later }
 // @mutant MUTANT_END_WITH_REQUESTER violates REQ_LC_007_end : a withdrawal removes every requester, so the warning ends when one of two requesters withdrew (C++ FAULT_LC_END_WITH_REQUESTER) [config TWO_TRAINS]
 // @mutant MUTANT_DEPART_WITHOUT_ALL_ACKS violates REQ_LC_009_departure : the departure signal is cleared with one acknowledgement missing (C++ FAULT_LC_DEPART_WITHOUT_ALL_ACKS) [config GNSS]
 // @mutant MUTANT_LATER_UPDATE_WHILE_WARNING violates REQ_LC_010_later : a later start time is stored although the warning for the departure has started (C++ FAULT_LC_LATER_UPDATE_WHILE_WARNING) [config GNSS]
-// @mutant MUTANT_CLEAR_ON_ANY_CLOSED violates REQ_LC_003_occupancy : a CLOSED report clears the train although it does not list the train among the requesters (the clearance rule of design §3 as written: a crossing closed for another train) [config TWO_TRAINS]
+// @mutant MUTANT_CLEAR_ON_ANY_CLOSED violates REQ_LC_003_occupancy : a CLOSED report clears the train although it does not list the train among the requesters (a crossing closed for another train; the earlier rule of design §3; C++ FAULT_LC_CLEAR_ON_ANY_CLOSED) [config TWO_TRAINS]
 // @mutant MUTANT_REQUEST_LATE violates REQ_LC_002_request : the request only half a tick after the ETA reached W + LEAD [config ONBOARD]
 // @mutant MUTANT_NO_DWELL violates REQ_LC_002_request : the ETA of a train standing in its dwell ignores the remaining dwell (request too early) [config ONBOARD]
 // @mutant MUTANT_NO_PROTECTION_REQUESTED violates REQ_LC_003_occupancy : a REQUESTED crossing gives no protection limit [config ONBOARD]
@@ -1350,8 +1371,8 @@ ltl REQ_LC_010_later { [] !v_later }
 
 // ---- coverage goals (trap properties) -------------------------------------------------------------
 // ONBOARD, per crossing: A = 0..19, B = 20..39 (same meaning)
-// @goal 0 REQ-LC-002 REQ-LC-001 : boundary: crossing A requested at exactly ETA = W + LEAD (running train)
-// @goal 1 REQ-LC-002 REQ-LC-001 : boundary: crossing A not requested at ETA half a tick above W + LEAD
+// @goal 0 REQ-LC-002 REQ-LC-001 : boundary: crossing A requested at exactly ETA = W + LEAD
+// @goal 1 REQ-LC-002 REQ-LC-005 : boundary: crossing A not requested at ETA one tick above W + LEAD (no ETA of the geometry lies strictly between)
 // @goal 2 REQ-LC-005 : boundary: crossing A requested in the dwell at exactly remaining dwell + ETA from rest = W + LEAD
 // @goal 3 REQ-LC-003 : boundary: crossing A cleared with the warning time exactly sufficient (ws + W = now + ETA)
 // @goal 4 REQ-LC-003 : crossing A not cleared: CLOSED for the train but warned too short for its ETA [config LONG_WARNING]
@@ -1369,8 +1390,8 @@ ltl REQ_LC_010_later { [] !v_later }
 // @goal 17 REQ-LC-004 : boundary: the rear exactly at A's far edge: PASSED, withdrawal
 // @goal 18 REQ-LC-004 : boundary: front beyond A's far edge, rear not: still CLEARED, no withdrawal
 // @goal 19 REQ-LC-003 : boundary: the train arrives at A exactly when its warning has lasted W
-// @goal 20 REQ-LC-002 REQ-LC-001 : boundary: crossing B requested at exactly ETA = W + LEAD (running train)
-// @goal 21 REQ-LC-002 REQ-LC-001 : boundary: crossing B not requested at ETA half a tick above W + LEAD
+// @goal 20 REQ-LC-002 REQ-LC-001 : boundary: crossing B requested at exactly ETA = W + LEAD
+// @goal 21 REQ-LC-002 REQ-LC-005 : boundary: crossing B not requested at ETA one tick above W + LEAD (no ETA of the geometry lies strictly between)
 // @goal 22 REQ-LC-005 : boundary: crossing B requested in the dwell at exactly remaining dwell + ETA from rest = W + LEAD
 // @goal 23 REQ-LC-003 : boundary: crossing B cleared with the warning time exactly sufficient
 // @goal 24 REQ-LC-003 : crossing B not cleared: CLOSED for the train but warned too short for its ETA [config LONG_WARNING]
@@ -1443,7 +1464,7 @@ ltl REQ_LC_010_later { [] !v_later }
 // @goal 92 REQ-LC-009 REQ-LC-013 : the departure signal held by a reported clock fault [config GNSS_CLOCK]
 // @goal 93 REQ-LC-012 : A's passage reported: warning stop pending [config GNSS]
 // @goal 94 REQ-LC-012 REQ-LC-014 : the rear passed A but no passage report arrived: the warning continues [config GNSS]
-// @goal 95 REQ-LC-010 REQ-LC-014 : an update of B lost: the centre's start time later than the one in force at B [config GNSS]
+// @goal 95 REQ-LC-010 REQ-LC-014 : a later update of B lost: B keeps the earlier start time in force (the centre's is later) [config GNSS]
 // @goal 96 REQ-LC-010 : a start time recomputed from a late position report (taken a tick before) [config GNSS]
 // @goal 97 REQ-LC-010 : a later start time of B computed from a train still standing at the station after t_dep [config GNSS]
 // @goal 98 REQ-LC-009 : an acknowledgement arriving a tick late [config GNSS]

@@ -260,11 +260,11 @@ def check_eta(x: int, v: int, dwell_ticks: int, near_hc: int, eta2: int, b: dict
 
 
 # ---- conversion to vector steps ------------------------------------------------------------------
-def _report(cid, status, ws, issued, clock_fault=False, requesters=None):
-    r = {"crossing_id": cid, "status": status, "warning_start_ms": ws, "issued_ms": issued, "clock_fault": clock_fault}
-    if requesters is not None:
-        r["requesters"] = requesters
-    return r
+def _report(cid, status, ws, issued, requesters, clock_fault=False):
+    """A controller report; it lists the controller's requesters (design §3 item 3: a CLOSED
+    report clears only a train it lists)."""
+    return {"crossing_id": cid, "status": status, "warning_start_ms": ws, "issued_ms": issued,
+            "clock_fault": clock_fault, "requesters": requesters}
 
 
 def _failure(prev_state, state, prev_failure):
@@ -309,14 +309,14 @@ def onboard_steps(ticks, b: dict, config):
             new_state = CONTROLLER_STATES[o["cs"]]
             if o["new"]:
                 ws[c] = now
-            if new_state in ("WARNING", "CLOSING", "CLOSED", "FAILED"):
+            failure[c] = _failure(state[c], new_state, failure[c])
+            if new_state in ("WARNING", "CLOSING", "CLOSED") or (new_state == "FAILED" and failure[c] != "BARRIER_NOT_UP"):
                 if min((now - ws[c]) // TICK_MS, t["W"]) != o["wa"]:
                     raise PipelineError(f"tick {k}: controller {c}: warning age {o['wa']} disagrees with ws {ws[c]}")
-            failure[c] = _failure(state[c], new_state, failure[c])
             state[c] = new_state
             status = STATUS_OF[new_state]
             rep = _report(CROSSING_IDS[c], status, ws[c] if status != "OPEN" else 0, now,
-                          requesters=list(requesters[c]) if two else None)
+                          list(requesters[c]))
             acks = [tr for tr in wds]
             if bool(o["ack"]) != (TRAIN_ID in acks):
                 raise PipelineError(f"tick {k}: controller {c}: acknowledgement disagrees with the model")
@@ -444,14 +444,14 @@ def gnss_steps(ticks, b: dict, config):
             new_state = CONTROLLER_STATES[g["cs"]]
             if g["new"]:
                 ws[c] = now
-            if new_state in ("WARNING", "CLOSING", "CLOSED", "FAILED"):
+            failure[c] = _failure(state[c], new_state, failure[c])
+            if new_state in ("WARNING", "CLOSING", "CLOSED") or (new_state == "FAILED" and failure[c] != "BARRIER_NOT_UP"):
                 if min((now - ws[c]) // TICK_MS, t["W"]) != g["wa"]:
                     raise PipelineError(f"tick {k}: controller {c}: warning age {g['wa']} disagrees with ws {ws[c]}")
-            failure[c] = _failure(state[c], new_state, failure[c])
             state[c] = new_state
             clock_state = CLOCK_STATES[g["ck"]]
             status = STATUS_OF[new_state]
-            rep = _report(CROSSING_IDS[c], status, ws[c] if status != "OPEN" else 0, now,
+            rep = _report(CROSSING_IDS[c], status, ws[c] if status != "OPEN" else 0, now, [],
                           clock_fault=clock_state == "FAULTY")
             sacks = [{"crossing_id": CROSSING_IDS[c], "departure_id": DEPARTURE_ID,
                       "start_ms": _start_ms(g["ack"] - 1, t), "stored": bool(g["acc"])}] if g["ack"] else []

@@ -354,6 +354,15 @@ def generate(model: Path, params_dir: Path, spec_dir: Path, workdir: Path, out_d
     return cov
 
 
+def _most_specific(err):
+    """The deepest error under a oneOf/anyOf failure, so that a message names the field that
+    is wrong (e.g. steps/0/onboard/in/reports/0: 'requesters' is a required property) instead
+    of quoting the whole line."""
+    while err is not None and err.context:
+        err = max(err.context, key=lambda e: len(e.absolute_path))
+    return err
+
+
 def schema_checked_jsonl(schema_path: Path, lines, name: str) -> str:
     """Validate every line (header and vectors) against the JSON schema of the vector
     format and return the JSON Lines text; a line that violates it is a PipelineError naming
@@ -361,10 +370,11 @@ def schema_checked_jsonl(schema_path: Path, lines, name: str) -> str:
     schema = json.loads(Path(schema_path).read_text(encoding="utf-8"))
     validator = jsonschema.Draft202012Validator(schema)
     for n, obj in enumerate(lines, 1):
-        err = next(iter(validator.iter_errors(obj)), None)
+        err = _most_specific(jsonschema.exceptions.best_match(validator.iter_errors(obj)))
         if err:
+            message = err.message if len(err.message) <= 300 else err.message[:300] + " ..."
             raise PipelineError(f"generated {name} line {n} violates the vector schema: "
-                                f"{'/'.join(map(str, err.path))}: {err.message}")
+                                f"{'/'.join(map(str, err.absolute_path)) or '(top level)'}: {message}")
     return "".join(json.dumps(o, sort_keys=True, separators=(",", ":")) + "\n" for o in lines)
 
 

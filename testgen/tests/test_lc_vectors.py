@@ -5,6 +5,7 @@ are parsed, converted to absolute times and C++ units, schema-checked, generated
 configuration, consistent with design note §3-§5 and cover every goal (or justify it)."""
 import copy
 import json
+import re
 import shutil
 from pathlib import Path
 
@@ -265,6 +266,13 @@ def test_schema_accepts_good_and_rejects_bad_records():
         with pytest.raises(PipelineError, match="violates the vector schema"):
             vectors.schema_checked_jsonl(SCHEMA, broken(edit), "level_crossing.jsonl")
             pytest.fail(f"schema accepted: {what}")
+    # the message names the field inside the vector (not the whole line) and stays short
+    no_list = broken(lambda ls: ls[1]["steps"][0]["onboard"]["in"]["reports"][0].pop("requesters"))
+    with pytest.raises(PipelineError) as info:
+        vectors.schema_checked_jsonl(SCHEMA, no_list, "level_crossing.jsonl")
+    assert "'requesters' is a required property" in str(info.value)
+    assert re.search(r"line 2 violates the vector schema: steps/0/\S*reports?\S*: ", str(info.value)), info.value
+    assert len(str(info.value)) < 500
 
 
 FILES = ["level_crossing.jsonl", "level_crossing.long_warning.jsonl", "level_crossing.two_trains.jsonl",
@@ -386,7 +394,7 @@ def test_boundary_vectors_hit_the_boundaries(generated):
     assert last["G0"]["onboard"]["out"]["states"][0] == "REQUESTED"
     assert last["G0"]["onboard"]["out"]["eta_half_ticks"][0] == 2 * (t["W"] + t["LEAD"])
     assert last["G1"]["onboard"]["out"]["states"][0] == "APPROACHING"
-    assert last["G1"]["onboard"]["out"]["eta_half_ticks"][0] == 2 * (t["W"] + t["LEAD"]) + 1
+    assert last["G1"]["onboard"]["out"]["eta_half_ticks"][0] == 2 * (t["W"] + t["LEAD"]) + 2
     # G2: requested in the dwell, the remaining dwell counted
     s = last["G2"]
     assert s["train"]["dwell"] and s["train"]["departure_ms"] > s["t_ms"]

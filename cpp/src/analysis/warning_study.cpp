@@ -349,6 +349,9 @@ struct PatternCheck {
 
 // The controller's reports for one request (design note §4): WARNING from the warning start,
 // CLOSED with the warning start once the barriers are detected down; one per ground cycle.
+// The one train of a passage (the study runs each passage alone).
+constexpr std::uint32_t kStudyTrainId = 1;
+
 struct Report {
   double delivered_ms = 0.0;  // true time at the train
   onboard::CrossingReport msg;
@@ -377,6 +380,8 @@ void StartController(Controller& c, const CrossingOfRun& cr, const CommsModel& c
     rep.msg.status = r >= closed_reading ? onboard::CrossingStatus::kClosed : onboard::CrossingStatus::kWarning;
     rep.msg.warning_start_ms = c.ws_reading;
     rep.msg.issued_ms = r;
+    rep.msg.requesters[0] = kStudyTrainId;  // the controller holds this train's request
+    rep.msg.requester_count = 1;
     rep.delivered_ms = std::max(last, static_cast<double>(r - e_x + cr.downlink_ms));
     last = rep.delivered_ms;
     c.reports.push_back(rep);
@@ -498,7 +503,7 @@ void RunOnboard(Method m, const ServiceSetup& s, const Timetable& tt, const Run&
   const std::size_t mi = static_cast<std::size_t>(m);
   std::optional<onboard::CrossingProtection> prot;
   if (m != Method::kOnboardApproach) {
-    onboard::ProtectionConfig cfg = onboard::DefaultProtectionConfig(1, t.length_mm, t.accel_max_mm_s2);
+    onboard::ProtectionConfig cfg = onboard::DefaultProtectionConfig(kStudyTrainId, t.length_mm, t.accel_max_mm_s2);
     cfg.request_lead_ms = lead;
     auto created = onboard::CrossingProtection::Create(cfg);
     if (created.error != onboard::ProtectionError::kNone) {

@@ -4,6 +4,7 @@
 //   FAULT_LC_CLEAR_WITHOUT_WARNING_TIME  clearance ignores ws + warning_time <= now + ETA
 //   FAULT_LC_STALE_CONFIRMATION          the age of a CLOSED confirmation is not checked
 //   FAULT_LC_WITHDRAW_AT_FRONT           withdrawal when the front (front_max) passed far
+//   FAULT_LC_CLEAR_ON_ANY_CLOSED         a CLOSED report clears although it does not list this train
 //
 // Magnitudes (EarliestArrivalMs): positions |x| <= 1e10, so a piece D <= 2e10; a <= 2e4;
 // speeds and caps <= 1e6 (kMaxLimitMmS, kMaxMeasuredSpeedMmS): c^2 <= 1e12, 2aD <= 8e14,
@@ -463,7 +464,14 @@ ProtectionError CrossingProtection::Cycle(const ProtectionInput& in) noexcept {
       if (r.crossing_id != c.id || r.issued_ms > now) {
         continue;
       }
-      if (e.state == CrossingState::kRequested && r.status == CrossingStatus::kClosed) {
+      // A confirmation is a CLOSED report that lists this train among the requesters; any
+      // other report of the crossing revokes a clearance (design §3 item 3).
+#if defined(FAULT_LC_CLEAR_ON_ANY_CLOSED)
+      const bool confirms = r.status == CrossingStatus::kClosed;
+#else
+      const bool confirms = r.status == CrossingStatus::kClosed && r.Lists(config_.train_id);
+#endif
+      if (e.state == CrossingState::kRequested && confirms) {
 #if defined(FAULT_LC_STALE_CONFIRMATION)
         const bool fresh = true;
 #else
@@ -479,7 +487,7 @@ ProtectionError CrossingProtection::Cycle(const ProtectionInput& in) noexcept {
           e.state = CrossingState::kCleared;
           e.cleared_ws_ms = r.warning_start_ms;
         }
-      } else if (e.state == CrossingState::kCleared && r.status != CrossingStatus::kClosed) {
+      } else if (e.state == CrossingState::kCleared && !confirms) {
         e.state = CrossingState::kRequested;
         e.cleared_ws_ms = 0;
       }

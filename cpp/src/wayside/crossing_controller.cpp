@@ -57,6 +57,8 @@ void CrossingController::ComputeOutputs(std::int64_t now_ms) noexcept {
   o.report.issued_ms = now_ms;
   o.report.clock_fault = status_.clock == ClockState::kFaulty;
   o.report.warning_start_ms = status_.warning_start_ms;
+  o.report.requesters = status_.requesters;
+  o.report.requester_count = status_.requester_count;
   switch (status_.state) {
     case ControllerState::kOpen:
     case ControllerState::kOpening:

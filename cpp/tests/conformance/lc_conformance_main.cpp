@@ -26,8 +26,8 @@
 // centre messages, departure signal and its block, the per-crossing state). The model's
 // ETA class eta2 = 2 floor(E) + (E not whole), E in ticks, is compared with the C++ eta_ms.
 // On a mismatch the failure names the vector, the step, the unit, the field, expected and
-// actual. A report's "requesters" field (the requester list proposed for the clearance rule,
-// see the model) has no C++ counterpart yet and is not fed.
+// actual. A report lists the controller's requesters; the on-board unit is cleared only by a
+// CLOSED report that lists it (design §3 item 3).
 // Last line: "railproof-conformance-lc: all N vectors passed" or
 // "railproof-conformance-lc: vectors mismatched: K of N" or "...: error: <reason>".
 #include <gtest/gtest.h>
@@ -192,7 +192,8 @@ bool IdsOk(const json& o, const char* k) {
 
 bool ReportOk(const json& r) {
   return r.is_object() && IsInt(r, "crossing_id") && r.contains("status") && r["status"].is_string() &&
-         IsInt(r, "warning_start_ms") && IsInt(r, "issued_ms") && IsBool(r, "clock_fault");
+         IsInt(r, "warning_start_ms") && IsInt(r, "issued_ms") && IsBool(r, "clock_fault") && IdsOk(r, "requesters") &&
+         r["requesters"].size() <= ob::kMaxReportRequesters;
 }
 
 bool ControllerStepOk(const json& c, bool gnss) {
@@ -378,8 +379,13 @@ ob::CrossingStatus StatusOf(const std::string& s) {
 }
 
 ob::CrossingReport ReportOf(const json& r) {
-  return ob::CrossingReport{static_cast<std::uint32_t>(I(r, "crossing_id")), StatusOf(r.at("status").get<std::string>()),
-                            I(r, "warning_start_ms"), I(r, "issued_ms"), r.at("clock_fault").get<bool>()};
+  ob::CrossingReport rep{static_cast<std::uint32_t>(I(r, "crossing_id")), StatusOf(r.at("status").get<std::string>()),
+                         I(r, "warning_start_ms"), I(r, "issued_ms"), r.at("clock_fault").get<bool>()};
+  const json& ids = r.at("requesters");  // at most kMaxReportRequesters (ReportOk)
+  for (const json& id : ids) {
+    rep.requesters[rep.requester_count++] = static_cast<std::uint32_t>(id.get<std::int64_t>());
+  }
+  return rep;
 }
 
 ws::ClockInput ClockOf(const std::string& s) {
@@ -394,7 +400,8 @@ ws::ClockInput ClockOf(const std::string& s) {
 
 std::string ReportString(const ob::CrossingReport& r) {
   return "{" + Str(r.crossing_id) + "," + ob::ToString(r.status) + ",ws=" + Str(r.warning_start_ms) +
-         ",issued=" + Str(r.issued_ms) + ",cf=" + Bool(r.clock_fault) + "}";
+         ",issued=" + Str(r.issued_ms) + ",cf=" + Bool(r.clock_fault) +
+         ",requesters=" + Ids(std::span<const std::uint32_t>(r.requesters.data(), r.requester_count)) + "}";
 }
 std::string ReportString(const json& r) { return ReportString(ReportOf(r)); }
 

@@ -217,14 +217,32 @@ constexpr const char* ToString(CrossingStatus s) noexcept {
 // of a confirmation from it (design §3 "received at rx": a delayed message is as old as its
 // issue, so the age from the issue time is the safe reading; with no delay both agree).
 // warning_start_ms (ws) is meaningful in kWarning and kClosed (and kFailed: the start of the
-// warning in force); clock_fault reports REQ-LC-013.
+// warning in force); clock_fault reports REQ-LC-013. requesters lists the trains among the
+// controller's requesters (design §3 item 3: a CLOSED report clears only a train it lists; a
+// crossing closed for another train is no confirmation for this one, whose own requests may
+// have been lost: the warning ends when that other train withdraws).
 // @implements REQ-LC-003 REQ-LC-006 REQ-LC-013
+inline constexpr std::size_t kMaxReportRequesters = 16;
 struct CrossingReport {
   std::uint32_t crossing_id = 0;
   CrossingStatus status = CrossingStatus::kOpen;
   std::int64_t warning_start_ms = 0;
   std::int64_t issued_ms = 0;
   bool clock_fault = false;
+  std::array<std::uint32_t, kMaxReportRequesters> requesters{};
+  std::size_t requester_count = 0;
+
+  // True if train_id is among the first requester_count entries (a count above the capacity
+  // is read as the capacity).
+  [[nodiscard]] constexpr bool Lists(std::uint32_t train_id) const noexcept {
+    const std::size_t n = requester_count < kMaxReportRequesters ? requester_count : kMaxReportRequesters;
+    for (std::size_t i = 0; i < n; ++i) {
+      if (requesters[i] == train_id) {
+        return true;
+      }
+    }
+    return false;
+  }
 };
 
 // A request or a withdrawal of the warning of one crossing by one train (design §3:

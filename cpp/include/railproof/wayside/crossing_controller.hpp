@@ -32,8 +32,8 @@ namespace railproof::wayside {
 using onboard::CrossingReport;
 using onboard::CrossingStatus;
 
-// Trains whose requests one controller holds at once.
-inline constexpr std::size_t kMaxRequesters = 16;
+// Trains whose requests one controller holds at once (the report lists all of them).
+inline constexpr std::size_t kMaxRequesters = onboard::kMaxReportRequesters;
 // Most entries per input list (requests, withdrawals, start times, warning stops) per cycle.
 inline constexpr std::size_t kMaxControllerMessages = 32;
 

@@ -28,7 +28,9 @@ using braking::RestrictionSegment;
 constexpr std::uint32_t kTrain = 7;
 constexpr std::int64_t kLength = 100'000;  // 100 m
 constexpr std::int64_t kW = 30'000;        // design warning time
-constexpr std::int64_t kLead = params::level_crossing::request_lead_ms;  // 6000
+constexpr std::int64_t kLead = params::level_crossing::request_lead_ms;
+// At a constant 20 m/s (20 mm/ms) the request distance is (warning + lead) x 20 mm/ms.
+constexpr std::int64_t kRequestDistMm = (kW + kLead) * 20;
 
 // Crossing 1 at [1,000,000, 1,006,000), crossing 2 at [2,000,000, 2,010,000).
 constexpr CrossingData kLc1{1, 1'000'000, 1'006'000, kW};
@@ -215,24 +217,24 @@ TEST(LcCrossingProtection, ConfigurationErrors) {
 
 // ---- request (REQ-LC-002) ---------------------------------------------------------------------
 
-// Constant 20 m/s, no acceleration: ETA = distance / 20 ms. warning + lead = 36 s = 720 m.
+// Constant 20 m/s, no acceleration: ETA = distance / 20 ms; requested at warning + lead.
 // @verifies REQ-LC-002
 TEST(LcCrossingProtection, RequestExactlyAtWarningTimePlusLead) {
   CrossingProtection p = Make();
   ASSERT_EQ(p.AddCrossing(kLc1), ProtectionError::kNone);
-  // ETA 36,001 ms (720,020 mm): not yet
-  ASSERT_EQ(p.Cycle(At(0, 1'000'000 - 720'020, 20'000)), ProtectionError::kNone);
+  // ETA warning + lead + 1 ms: not yet
+  ASSERT_EQ(p.Cycle(At(0, 1'000'000 - kRequestDistMm - 20, 20'000)), ProtectionError::kNone);
   EXPECT_EQ(p.Find(1)->eta_ms, kW + kLead + 1);
   EXPECT_EQ(StateOf(p, 1), CrossingState::kApproaching);
   EXPECT_TRUE(p.Output().Requests().empty());
-  // ETA exactly 36,000 ms: requested, and the request is sent in the same cycle
-  ASSERT_EQ(p.Cycle(At(1, 1'000'000 - 720'000, 20'000)), ProtectionError::kNone);
+  // ETA exactly warning + lead: requested, and the request is sent in the same cycle
+  ASSERT_EQ(p.Cycle(At(1, 1'000'000 - kRequestDistMm, 20'000)), ProtectionError::kNone);
   EXPECT_EQ(p.Find(1)->eta_ms, kW + kLead);
   EXPECT_EQ(StateOf(p, 1), CrossingState::kRequested);
   ASSERT_EQ(p.Output().Requests().size(), 1U);
   EXPECT_EQ(p.Output().Requests()[0], 1U);
   // repeated every cycle, also when the train stops
-  ASSERT_EQ(p.Cycle(At(2, 1'000'000 - 720'000, 0)), ProtectionError::kNone);
+  ASSERT_EQ(p.Cycle(At(2, 1'000'000 - kRequestDistMm, 0)), ProtectionError::kNone);
   EXPECT_EQ(p.Find(1)->eta_ms, kEtaNeverMs);
   EXPECT_EQ(StateOf(p, 1), CrossingState::kRequested);
   EXPECT_EQ(p.Output().Requests().size(), 1U);
@@ -244,7 +246,7 @@ TEST(LcCrossingProtection, RequestExactlyAtWarningTimePlusLead) {
 TEST(LcCrossingProtection, RequestUsesTheFrontOfTheEnvelope) {
   CrossingProtection p = Make();
   ASSERT_EQ(p.AddCrossing(kLc1), ProtectionError::kNone);
-  ProtectionInput in = At(0, 1'000'000 - 720'020, 20'000);
+  ProtectionInput in = At(0, 1'000'000 - kRequestDistMm - 20, 20'000);
   in.front_error_mm = 20;
   ASSERT_EQ(p.Cycle(in), ProtectionError::kNone);
   EXPECT_EQ(StateOf(p, 1), CrossingState::kRequested);
@@ -281,6 +283,17 @@ CrossingProtection Requested(std::int64_t now = 10'000) {
   return p;
 }
 
+// A controller report of crossing `id` listing this train among the requesters (unless
+// `listed` is false: a report held for other trains only).
+CrossingReport Rep(std::uint32_t id, CrossingStatus status, std::int64_t ws, std::int64_t issued, bool listed = true) {
+  CrossingReport r{id, status, ws, issued, false};
+  if (listed) {
+    r.requesters[0] = kTrain;
+    r.requester_count = 1;
+  }
+  return r;
+}
+
 ProtectionInput WithReport(ProtectionInput in, const std::array<CrossingReport, 1>& r) {
   in.reports = r;
   return in;
@@ -291,7 +304,7 @@ ProtectionInput WithReport(ProtectionInput in, const std::array<CrossingReport, 
 TEST(LcCrossingProtection, ClearanceNeedsTheWarningTimeBeforeArrival) {
   {
     CrossingProtection p = Requested();
-    const std::array<CrossingReport, 1> late{{{1, CrossingStatus::kClosed, 1, 10'000, false}}};
+    const std::array<CrossingReport, 1> late{{Rep(1, CrossingStatus::kClosed, 1, 10'000)}};
     ASSERT_EQ(p.Cycle(WithReport(At(10'000, 600'000, 20'000), late)), ProtectionError::kNone);
     EXPECT_EQ(StateOf(p, 1), CrossingState::kRequested);  // ws 1 ms too late
     EXPECT_EQ(p.Output().stop_limit_mm, kLc1.near_mm - params::level_crossing::protection_offset_mm);
@@ -299,7 +312,7 @@ TEST(LcCrossingProtection, ClearanceNeedsTheWarningTimeBeforeArrival) {
   }
   {
     CrossingProtection p = Requested();
-    const std::array<CrossingReport, 1> exact{{{1, CrossingStatus::kClosed, 0, 10'000, false}}};
+    const std::array<CrossingReport, 1> exact{{Rep(1, CrossingStatus::kClosed, 0, 10'000)}};
     ASSERT_EQ(p.Cycle(WithReport(At(10'000, 600'000, 20'000), exact)), ProtectionError::kNone);
     EXPECT_EQ(StateOf(p, 1), CrossingState::kCleared);
     EXPECT_EQ(p.Find(1)->cleared_ws_ms, 0);
@@ -314,21 +327,21 @@ TEST(LcCrossingProtection, ClearanceNeedsAFreshConfirmation) {
   const std::int64_t max_age = params::level_crossing::confirmation_max_age_ms;
   {
     CrossingProtection p = Requested();
-    const std::array<CrossingReport, 1> stale{{{1, CrossingStatus::kClosed, -10'000, 13'000 - max_age - 1, false}}};
+    const std::array<CrossingReport, 1> stale{{Rep(1, CrossingStatus::kClosed, -10'000, 13'000 - max_age - 1)}};
     ASSERT_EQ(p.Cycle(WithReport(At(13'000, 660'000, 20'000), stale)), ProtectionError::kNone);
     EXPECT_EQ(StateOf(p, 1), CrossingState::kRequested);
     EXPECT_TRUE(p.Output().stop_limit_mm.has_value());
   }
   {
     CrossingProtection p = Requested();
-    const std::array<CrossingReport, 1> fresh{{{1, CrossingStatus::kClosed, -10'000, 13'000 - max_age, false}}};
+    const std::array<CrossingReport, 1> fresh{{Rep(1, CrossingStatus::kClosed, -10'000, 13'000 - max_age)}};
     ASSERT_EQ(p.Cycle(WithReport(At(13'000, 660'000, 20'000), fresh)), ProtectionError::kNone);
     EXPECT_EQ(StateOf(p, 1), CrossingState::kCleared);
   }
   {
     // a report stamped in the future is ignored
     CrossingProtection p = Requested();
-    const std::array<CrossingReport, 1> future{{{1, CrossingStatus::kClosed, -10'000, 13'001, false}}};
+    const std::array<CrossingReport, 1> future{{Rep(1, CrossingStatus::kClosed, -10'000, 13'001)}};
     ASSERT_EQ(p.Cycle(WithReport(At(13'000, 660'000, 20'000), future)), ProtectionError::kNone);
     EXPECT_EQ(StateOf(p, 1), CrossingState::kRequested);
     EXPECT_EQ(p.Output().ignored_messages, 1U);
@@ -338,9 +351,9 @@ TEST(LcCrossingProtection, ClearanceNeedsAFreshConfirmation) {
 // @verifies REQ-LC-003
 TEST(LcCrossingProtection, OnlyAClosedReportOfThisCrossingClears) {
   CrossingProtection p = Requested();
-  const std::array<CrossingReport, 3> reports{{{1, CrossingStatus::kWarning, -20'000, 10'000, false},
-                                               {1, CrossingStatus::kFailed, -20'000, 10'000, false},
-                                               {5, CrossingStatus::kClosed, -20'000, 10'000, false}}};
+  const std::array<CrossingReport, 3> reports{{Rep(1, CrossingStatus::kWarning, -20'000, 10'000),
+                                               Rep(1, CrossingStatus::kFailed, -20'000, 10'000),
+                                               Rep(5, CrossingStatus::kClosed, -20'000, 10'000)}};
   ProtectionInput in = At(10'000, 600'000, 20'000);
   in.reports = reports;
   ASSERT_EQ(p.Cycle(in), ProtectionError::kNone);
@@ -353,7 +366,7 @@ TEST(LcCrossingProtection, OnlyAClosedReportOfThisCrossingClears) {
 TEST(LcCrossingProtection, NoClearanceWhileApproaching) {
   CrossingProtection p = Make();
   ASSERT_EQ(p.AddCrossing(kLc1), ProtectionError::kNone);
-  const std::array<CrossingReport, 1> closed{{{1, CrossingStatus::kClosed, -100'000, 0, false}}};
+  const std::array<CrossingReport, 1> closed{{Rep(1, CrossingStatus::kClosed, -100'000, 0)}};
   ASSERT_EQ(p.Cycle(WithReport(At(0, 0, 20'000), closed)), ProtectionError::kNone);  // ETA 50 s
   EXPECT_EQ(StateOf(p, 1), CrossingState::kApproaching);
 }
@@ -363,15 +376,54 @@ TEST(LcCrossingProtection, NoClearanceWhileApproaching) {
 TEST(LcCrossingProtection, FailedOpenOrWarningReportReprotects) {
   for (const CrossingStatus s : {CrossingStatus::kFailed, CrossingStatus::kOpen, CrossingStatus::kWarning}) {
     CrossingProtection p = Requested();
-    const std::array<CrossingReport, 1> closed{{{1, CrossingStatus::kClosed, -20'000, 10'000, false}}};
+    const std::array<CrossingReport, 1> closed{{Rep(1, CrossingStatus::kClosed, -20'000, 10'000)}};
     ASSERT_EQ(p.Cycle(WithReport(At(10'000, 600'000, 20'000), closed)), ProtectionError::kNone);
     ASSERT_EQ(StateOf(p, 1), CrossingState::kCleared);
-    const std::array<CrossingReport, 1> bad{{{1, s, -20'000, 10'500, false}}};
+    const std::array<CrossingReport, 1> bad{{Rep(1, s, -20'000, 10'500)}};
     ASSERT_EQ(p.Cycle(WithReport(At(10'500, 610'000, 20'000), bad)), ProtectionError::kNone);
     EXPECT_EQ(StateOf(p, 1), CrossingState::kRequested) << ToString(s);
     EXPECT_EQ(p.Output().stop_limit_mm, kLc1.near_mm - params::level_crossing::protection_offset_mm);
     EXPECT_EQ(p.Output().Requests().size(), 1U);
   }
+}
+
+// A crossing closed for other trains is no confirmation for this one (its own requests may
+// have been lost; the warning ends when those trains withdraw): a CLOSED report clears only
+// if it lists this train, and a cleared crossing whose CLOSED report no longer lists the
+// train is protected again (design §3 item 3; model mutant MUTANT_CLEAR_ON_ANY_CLOSED).
+// @verifies REQ-LC-003
+// @verifies REQ-LC-014
+TEST(LcCrossingProtection, ClosedReportClearsOnlyATrainItLists) {
+  CrossingProtection p = Requested();
+  CrossingReport other = Rep(1, CrossingStatus::kClosed, -20'000, 10'000, false);
+  other.requesters[0] = kTrain + 1;
+  other.requester_count = 1;
+  const std::array<CrossingReport, 1> for_other{{other}};
+  ASSERT_EQ(p.Cycle(WithReport(At(10'000, 600'000, 20'000), for_other)), ProtectionError::kNone);
+  EXPECT_EQ(StateOf(p, 1), CrossingState::kRequested);
+  EXPECT_EQ(p.Output().stop_limit_mm, kLc1.near_mm - params::level_crossing::protection_offset_mm);
+
+  CrossingReport both = other;
+  both.requesters[1] = kTrain;
+  both.requester_count = 2;
+  const std::array<CrossingReport, 1> listed{{both}};
+  ASSERT_EQ(p.Cycle(WithReport(At(10'000, 600'000, 20'000), listed)), ProtectionError::kNone);
+  EXPECT_EQ(StateOf(p, 1), CrossingState::kCleared);
+
+  // the controller lost this train's request (e.g. a restart): CLOSED, listing only the other
+  ASSERT_EQ(p.Cycle(WithReport(At(10'500, 610'000, 20'000), for_other)), ProtectionError::kNone);
+  EXPECT_EQ(StateOf(p, 1), CrossingState::kRequested);
+  EXPECT_EQ(p.Output().Requests().size(), 1U);  // the request is sent again
+}
+
+// A requester count above the report's capacity is read as the capacity (no read past it).
+// @verifies REQ-LC-003
+TEST(LcCrossingProtection, RequesterCountAboveCapacityIsBounded) {
+  CrossingReport r = Rep(1, CrossingStatus::kClosed, 0, 0, false);
+  r.requester_count = kMaxReportRequesters + 5;
+  EXPECT_FALSE(r.Lists(kTrain));
+  r.requesters[kMaxReportRequesters - 1] = kTrain;
+  EXPECT_TRUE(r.Lists(kTrain));
 }
 
 // The most restrictive limit of the uncleared crossings is given.
@@ -385,7 +437,7 @@ TEST(LcCrossingProtection, MostRestrictiveProtectionLimit) {
   ASSERT_EQ(p.Cycle(At(10'000, 600'000, 20'000)), ProtectionError::kNone);
   EXPECT_EQ(p.Output().stop_limit_mm, kLc1.near_mm - off);
   EXPECT_EQ(p.Output().limiting_crossing_id, 1U);
-  const std::array<CrossingReport, 1> closed{{{1, CrossingStatus::kClosed, -20'000, 10'000, false}}};
+  const std::array<CrossingReport, 1> closed{{Rep(1, CrossingStatus::kClosed, -20'000, 10'000)}};
   ASSERT_EQ(p.Cycle(WithReport(At(10'000, 600'000, 20'000), closed)), ProtectionError::kNone);
   EXPECT_EQ(p.Output().stop_limit_mm, kLc2.near_mm - off);
   EXPECT_EQ(p.Output().limiting_crossing_id, 2U);
@@ -396,7 +448,7 @@ TEST(LcCrossingProtection, MostRestrictiveProtectionLimit) {
 // Cleared crossing 1, the train running through it.
 CrossingProtection Cleared() {
   CrossingProtection p = Requested();
-  const std::array<CrossingReport, 1> closed{{{1, CrossingStatus::kClosed, -20'000, 10'000, false}}};
+  const std::array<CrossingReport, 1> closed{{Rep(1, CrossingStatus::kClosed, -20'000, 10'000)}};
   EXPECT_EQ(p.Cycle(WithReport(At(10'000, 600'000, 20'000), closed)), ProtectionError::kNone);
   EXPECT_EQ(StateOf(p, 1), CrossingState::kCleared);
   return p;
@@ -472,30 +524,37 @@ TEST(LcCrossingProtection, AckBeforeAnyWithdrawalIsNotTaken) {
 // ---- dwell-aware request (REQ-LC-005) ------------------------------------------------------
 
 // Standing 100 m before the crossing at a stop, departure at t_dep = 100 s, accel 1 m/s^2:
-// the run from rest takes 14,142 ms; the request comes when (t_dep - now) + 14,142 <= 36,000,
-// i.e. at now >= 78,142; without dwell awareness (speed 0, never) it would never come, and a
-// prediction ignoring the dwell (departing now) would request 85.8 s too early.
+// the run from rest takes 14,142 ms; the request comes when (t_dep - now) + 14,142 <= warning
+// + lead, i.e. at now >= t_req = t_dep + 14,142 - (warning + lead); without dwell awareness
+// (speed 0, never) it would never come, and a prediction ignoring the dwell (departing now)
+// would request (t_dep - t_req) too early.
 // @verifies REQ-LC-005
 TEST(LcCrossingProtection, DwellAwareRequest) {
+  constexpr std::int64_t kDep = 100'000;
+  constexpr std::int64_t kRun = 14'142;
+  constexpr std::int64_t kReq = kDep + kRun - (kW + kLead);
+  static_assert(kReq > 0 && kReq < kDep);
   CrossingProtection p = Make(1'000);
   ASSERT_EQ(p.AddCrossing(kLc1), ProtectionError::kNone);
-  ProtectionInput in = At(78'141, 900'000, 0);
+  ProtectionInput in = At(kReq - 1, 900'000, 0);
   in.dwell = true;
-  in.departure_ms = 100'000;
+  in.departure_ms = kDep;
   ASSERT_EQ(p.Cycle(in), ProtectionError::kNone);
-  EXPECT_EQ(p.Find(1)->eta_ms, 21'859 + 14'142);
+  EXPECT_EQ(p.Find(1)->eta_ms, kDep - (kReq - 1) + kRun);
   EXPECT_EQ(StateOf(p, 1), CrossingState::kApproaching);
   EXPECT_EQ(p.Output().stop_limit_mm, kLc1.near_mm - params::level_crossing::protection_offset_mm);
-  in.now_ms = 78'142;
+  in.now_ms = kReq;
   ASSERT_EQ(p.Cycle(in), ProtectionError::kNone);
   EXPECT_EQ(p.Find(1)->eta_ms, kW + kLead);
   EXPECT_EQ(StateOf(p, 1), CrossingState::kRequested);
-  // the clearance is judged against the dwell-aware ETA too: ws + 30 s <= 78,142 + 36,000
-  const std::array<CrossingReport, 1> closed{{{1, CrossingStatus::kClosed, 84'142, 84'142, false}}};
-  in.now_ms = 84'142;
+  // the clearance is judged against the dwell-aware ETA too: at now = t_dep + 14,142 - 30 s a
+  // warning started then is exactly sufficient (ws + 30 s = now + ETA)
+  constexpr std::int64_t kNow = kDep + kRun - kW;
+  const std::array<CrossingReport, 1> closed{{Rep(1, CrossingStatus::kClosed, kNow, kNow)}};
+  in.now_ms = kNow;
   in.reports = closed;
   ASSERT_EQ(p.Cycle(in), ProtectionError::kNone);
-  EXPECT_EQ(p.Find(1)->eta_ms, 15'858 + 14'142);
+  EXPECT_EQ(p.Find(1)->eta_ms, kDep - kNow + kRun);
   EXPECT_EQ(StateOf(p, 1), CrossingState::kCleared);
 }
 
@@ -540,7 +599,7 @@ std::vector<std::int64_t> Journey(CrossingProtection& p) {
     std::array<CrossingReport, 2> reports{};
     std::size_t n = 0;
     for (const std::uint32_t id : p.Output().Requests()) {
-      reports[n++] = CrossingReport{id, CrossingStatus::kClosed, now - 40'000, now, false};
+      reports[n++] = Rep(id, CrossingStatus::kClosed, now - 40'000, now);
     }
     std::array<WithdrawalAck, 2> acks{};
     std::size_t m = 0;
@@ -586,7 +645,7 @@ TEST(LcCrossingProtection, NoHeapInTheCycle) {
   for (std::int64_t i = 0; i < 200; ++i) {
     profile.push_back({i * 20'000, i * 20'000 + 10'000, 15'000 + (i % 4) * 5'000});
   }
-  const std::array<CrossingReport, 1> closed{{{1, CrossingStatus::kClosed, 0, 30'000, false}}};
+  const std::array<CrossingReport, 1> closed{{Rep(1, CrossingStatus::kClosed, 0, 30'000)}};
   testing::StartCountingAllocations();
   std::int64_t sum = 0;
   for (std::int64_t k = 0; k < 100; ++k) {

@@ -507,6 +507,7 @@ TEST(LcCrossingController, TypedErrors) {
 }
 
 // More requesters than kMaxRequesters: the warning can then not end automatically.
+// @verifies REQ-LC-003
 // @verifies REQ-LC-007
 // @verifies REQ-LC-014
 TEST(LcCrossingController, RequesterOverflowKeepsWarning) {
@@ -521,11 +522,19 @@ TEST(LcCrossingController, RequesterOverflowKeepsWarning) {
   EXPECT_TRUE(c.Status().requester_overflow);
   ASSERT_EQ(c.Cycle(Moving(kLower)), ControllerError::kNone);
   ASSERT_EQ(c.Cycle(Down(9'000)), ControllerError::kNone);
+  // the CLOSED report lists the stored requesters; the train beyond the capacity is not
+  // listed, so it is never confirmed (design §4) and stops at its protection limit
+  ASSERT_EQ(c.Output().report.status, CrossingStatus::kClosed);
+  EXPECT_EQ(c.Output().report.requester_count, kMaxRequesters);
+  EXPECT_TRUE(c.Output().report.Lists(1));
+  EXPECT_TRUE(c.Output().report.Lists(static_cast<std::uint32_t>(kMaxRequesters)));
+  EXPECT_FALSE(c.Output().report.Lists(static_cast<std::uint32_t>(kMaxRequesters + 1)));
   in = Down(10'000);
   in.withdrawals = std::span<const std::uint32_t>(trains.data(), kMaxRequesters);
   ASSERT_EQ(c.Cycle(in), ControllerError::kNone);
   EXPECT_TRUE(c.Status().Requesters().empty());
   EXPECT_EQ(c.State(), ControllerState::kClosed);
+  EXPECT_EQ(c.Output().report.requester_count, 0U);
 }
 
 std::vector<std::int64_t> RunController(CrossingController& c) {
