@@ -928,6 +928,9 @@ class Model:
                   if str(m.get("property") or "").startswith("assert:")}
         listed = {p["name"][7:] for p in props if p["name"].startswith("assert:")}
         checking = [p for p in runs if _pan_checks_assertions(str(p.get("command") or ""))]
+        # properties verified together share one search (one configuration and command)
+        n_runs = len({(str(p.get("configuration") or "default"), str(p.get("command") or ""))
+                      for p in checking})
         out = []
         for label in sorted(named - listed):
             name = f"assert:{label}"
@@ -944,12 +947,12 @@ class Model:
                          "assertions")
             elif bad:
                 verdict = "not established"
-                basis = (f"{len(bad)} of the {len(checking)} verification runs of this model did "
+                basis = (f"{len(bad)} of the {len(checking)} property results of this model did "
                          f"not complete without an error (first: {bad[0].get('name')})")
             else:
                 verdict = "verified"
                 basis = (f"pan checks every assert() of the model in every run not started with "
-                         f"-A; all {len(checking)} verification runs of this model "
+                         f"-A; all {n_runs} verification runs of this model "
                          f"(configurations: {', '.join(configs)}) searched their whole state "
                          "space without an error")
             if killers:
@@ -966,8 +969,8 @@ class Model:
                       "named by a mutant or by trace.json; the model source is not in this package")
             out.append({"id": nid, "name": name, "label": label, "kind": "assertion",
                         "verdict": verdict, "text": ann["text"] if ann else "", "basis": basis,
-                        "states": f"in {len(checking)} runs" if checking else "n/a",
-                        "origin": origin, "runs": len(checking), "configurations": ", ".join(configs),
+                        "states": f"in {n_runs} runs" if checking else "n/a",
+                        "origin": origin, "runs": n_runs, "configurations": ", ".join(configs),
                         "links": [r for r in reqs if r in self.req_ids],
                         "unknown": [r for r in reqs if r not in self.req_ids]})
             self.prop_by_name.setdefault(name, nid)

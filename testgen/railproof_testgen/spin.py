@@ -1,10 +1,19 @@
 """Run SPIN: exhaustive verification of every named property, and the mutant models.
 
 `verify` compiles the model once per configuration (pan with -DBFS -DSAFETY: a complete
-breadth-first search; for safety properties it is exhaustive and needs no depth bound),
-runs `./pan -N <property>` for every `// @property`, then compiles and runs every
+breadth-first search; for safety properties it is exhaustive and needs no depth bound) and
+verifies every `// @property` of the configuration, then compiles and runs every
 `// @mutant`, which must be rejected. Any violated or incomplete property fails the
 command with the counterexample shown; so does a surviving mutant.
+
+Every property of the models is an invariant, `ltl NAME { [] p }`. The properties of one
+configuration are verified together in one search of the conjunction, `[] (p1 && p2 ...)`
+(the claim `railproof_all`, appended to a copy of the model; [] (p1 && p2) holds exactly when
+[] p1 and [] p2 hold), so the state space of a configuration is searched once instead of
+once per property. If that search does not verify, every property of the configuration is
+searched on its own, so a violation is reported against the property it breaks, with its
+own counterexample. A configuration with one property, or with a property that is not of
+the form `[] p`, is always searched per property.
 """
 from __future__ import annotations
 
@@ -33,6 +42,20 @@ _CONFIG = re.compile(r"\[config\s+(\w+(?:\s+\w+)*)\]")
 _PAN_FLAGS = re.compile(r"^\s*//\s*@pan_flags\s+((?:-D\w+(?:=\w+)?\s*)+)$")
 
 PAN_FLAGS = ["-O2", "-DSAFETY", "-DBFS", "-DMEMLIM=8000"]
+
+# an invariant claim on one line: ltl NAME { [] p }
+_LTL_INVARIANT = re.compile(r"^\s*ltl\s+(\w+)\s*\{\s*\[\]\s*(.+?)\s*\}\s*(?://.*)?$", re.M)
+COMBINED_CLAIM = "railproof_all"
+
+
+def invariant_claims(model_text: str) -> dict:
+    """{claim name: p} for every claim of the form `ltl NAME { [] p }` on one line."""
+    return {m.group(1): m.group(2) for m in _LTL_INVARIANT.finditer(model_text)}
+
+
+def combined_claim(bodies: list) -> str:
+    """The conjunction of invariants as one claim (see the module docstring)."""
+    return f"ltl {COMBINED_CLAIM} {{ [] ({' && '.join(f'({b})' for b in bodies)}) }}\n"
 
 
 @dataclass
@@ -185,13 +208,18 @@ def _run(cmd, cwd, timeout=None):
     raise AssertionError("unreachable")
 
 
-def prepare(model: Path, params_dir: Path, workdir: Path, defines=(), extra_files=(), cflags=None):
-    """Copy the model and its generated includes into workdir, run spin -a, compile pan."""
+def prepare(model: Path, params_dir: Path, workdir: Path, defines=(), extra_files=(), cflags=None,
+            extra_claim: str | None = None):
+    """Copy the model and its generated includes into workdir, run spin -a, compile pan.
+    extra_claim (an `ltl` line) is appended to the copy of the model."""
     workdir = Path(workdir)
     if workdir.exists():
         shutil.rmtree(workdir)
     workdir.mkdir(parents=True)
     shutil.copy2(model, workdir / Path(model).name)
+    if extra_claim:
+        with open(workdir / Path(model).name, "a", encoding="utf-8") as f:
+            f.write("\n" + extra_claim)
     for inc in Path(params_dir).glob("*.pml"):
         shutil.copy2(inc, workdir / inc.name)
     for f in extra_files:
@@ -262,23 +290,29 @@ def verify(model: Path, params_dir: Path, workdir: Path, out_json: Path, jobs: i
     runs += [(p, v.define) for v in ann.variants for p in ann.properties if p.config is None]
     configs = sorted({c for _, c in runs}, key=lambda c: c or "")
     t0 = time.monotonic()
+    claims = invariant_claims(model.read_text(encoding="utf-8"))
+    in_config = {c: [p for p, rc in runs if rc == c] for c in configs}
+    # configurations searched once for the conjunction of their properties
+    combined = {c: ps for c, ps in in_config.items() if len(ps) > 1 and all(p.name in claims for p in ps)}
     dirs = {}
     for cfg in configs:
         name = cfg or "default"
         _progress(f"compiling {model.name} [{name}]")
-        dirs[cfg] = prepare(model, params_dir, Path(workdir) / f"verify-{name}", [cfg] if cfg else [])
+        extra = combined_claim([claims[p.name] for p in combined[cfg]]) if cfg in combined else None
+        dirs[cfg] = prepare(model, params_dir, Path(workdir) / f"verify-{name}", [cfg] if cfg else [],
+                            extra_claim=extra)
+    pan_cc = f"cc {' '.join(PAN_FLAGS + ann.pan_flags)} -o pan pan.c"
 
-    def run_prop(run):
-        p, config = run
-        # each property in its own copy of the binary's directory: pan writes the trail there
-        wd = Path(workdir) / f"prop-{p.name}-{config or 'default'}"
+    def run_claim(claim: str, config, tag: str):
+        # each run in its own copy of the binary's directory: pan writes the trail there
+        wd = Path(workdir) / f"prop-{tag}-{config or 'default'}"
         if wd.exists():
             shutil.rmtree(wd)
         shutil.copytree(dirs[config], wd)
-        r = _run(["./pan", "-N", p.name], wd)
+        r = _run(["./pan", "-N", claim], wd)
         res = parse_pan(r.stdout + r.stderr)
         if res["errors"] is None:
-            raise PipelineError(f"{model.name}: pan -N {p.name}: unexpected output:\n{r.stdout[-2000:]}{r.stderr[-2000:]}")
+            raise PipelineError(f"{model.name}: pan -N {claim}: unexpected output:\n{r.stdout[-2000:]}{r.stderr[-2000:]}")
         verdict = "verified"
         cex = None
         if res["errors"]:
@@ -286,18 +320,57 @@ def verify(model: Path, params_dir: Path, workdir: Path, out_json: Path, jobs: i
             cex = counterexample(wd, model.name, [config] if config else [])
         elif res["incomplete"]:
             verdict = "incomplete"
+        return verdict, cex, res
+
+    def record(p, config, verdict, cex, res, command, extra=None):
+        return {"name": p.name, "requirements": p.requirements, "text": p.text,
+                "configuration": config or "default", "verdict": verdict, "command": command,
+                "counterexample": cex, **(extra or {}),
+                **{k: v for k, v in res.items() if k != "violated_expression"}}
+
+    def run_prop(run):
+        p, config = run
+        verdict, cex, res = run_claim(p.name, config, p.name)
         _progress(f"{p.name} [{config or 'default'}]: {verdict} ({res['states_stored']} states, "
                   f"depth {res['depth']}, {res['time_s']} s)")
-        return {"name": p.name, "requirements": p.requirements, "text": p.text,
-                "configuration": config or "default", "verdict": verdict,
-                "command": f"spin {'-D' + config + ' ' if config else ''}-a {model.name} && "
-                           f"cc {' '.join(PAN_FLAGS + ann.pan_flags)} -o pan pan.c && ./pan -N {p.name}",
-                "counterexample": cex, **{k: v for k, v in res.items() if k != "violated_expression"}}
+        return record(p, config, verdict, cex, res,
+                      f"spin {'-D' + config + ' ' if config else ''}-a {model.name} && {pan_cc} && ./pan -N {p.name}")
 
+    def run_combined(config):
+        ps = combined[config]
+        verdict, _cex, res = run_claim(COMBINED_CLAIM, config, COMBINED_CLAIM)
+        names = [p.name for p in ps]
+        _progress(f"{len(ps)} properties together [{config or 'default'}]: {verdict} "
+                  f"({res['states_stored']} states, depth {res['depth']}, {res['time_s']} s)")
+        if verdict != "verified":
+            return config, None
+        claim = combined_claim([claims[n] for n in names]).strip()
+        stem = model.stem
+        command = (f"(cat {model.name}; echo '{claim}') > {stem}_all.pml && "
+                   f"spin {'-D' + config + ' ' if config else ''}-a {stem}_all.pml && {pan_cc} && "
+                   f"./pan -N {COMBINED_CLAIM}")
+        return config, [record(p, config, verdict, None, res, command,
+                               {"verified_with": [n for n in names if n != p.name]}) for p in ps]
+
+    single = [(p, c) for p, c in runs if c not in combined]
     _progress(f"verifying {len(ann.properties)} properties in {len(configs)} configuration(s): "
-              f"{len(runs)} runs with {jobs} job(s)")
+              f"{len(combined)} combined searches and {len(single)} single-property searches "
+              f"with {jobs} job(s)")
+    results = {}
     with ThreadPoolExecutor(max_workers=max(1, jobs)) as ex:
-        props = list(ex.map(run_prop, runs))
+        futures = [ex.submit(run_combined, c) for c in combined] + [ex.submit(run_prop, r) for r in single]
+        for f in futures:
+            out = f.result()
+            if isinstance(out, tuple):
+                config, recs = out
+                if recs is None:  # search every property of the configuration on its own
+                    _progress(f"[{config or 'default'}]: not verified together; searching per property")
+                    recs = list(ex.map(run_prop, [(p, config) for p in combined[config]]))
+                for r in recs:
+                    results[(r["name"], config)] = r
+            else:
+                results[(out["name"], None if out["configuration"] == "default" else out["configuration"])] = out
+    props = [results[(p.name, c)] for p, c in runs]
 
     def run_mutant(mu: Mutant):
         mdefs = [mu.name] + ([mu.config] if mu.config else [])
@@ -330,8 +403,8 @@ def verify(model: Path, params_dir: Path, workdir: Path, out_json: Path, jobs: i
     assertions = [{"name": f"assert:{label}", "requirements": reqs, "text": text,
                    "verdict": "verified" if all_clean else
                    ("violated" if any(p["errors"] for p in props) else "incomplete"),
-                   "runs": len(props),
-                   "basis": "checked in every property run of every configuration listed in properties"}
+                   "runs": len({(p["configuration"], p["command"]) for p in props}),
+                   "basis": "checked in every verification run of every configuration listed in properties"}
                   for label, (_expr, reqs, text) in sorted(ann.asserts.items())]
     result = {
         "schema": "railproof/spin-results/1",

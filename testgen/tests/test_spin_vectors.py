@@ -119,3 +119,71 @@ def test_run_retries_text_file_busy_and_raises_other_errors(monkeypatch):
     monkeypatch.setattr(spin.subprocess, "run", missing)
     with pytest.raises(OSError):
         spin._run(["true"], ".")
+
+
+TWO_INVARIANTS = """/* two invariants of one counter (tests of the combined search) */
+#include "two_params.pml"
+byte x;
+bit v_over, v_big;
+active proctype env() {
+  do
+  :: d_step { printf("@IN tick\\n"); x = (x + 1) % MODEL_WRAP;
+              printf("@OUT tx seq=%d echo=255 link=0 eb=1 abnormal=1\\n", x);
+              if :: x >= MODEL_LIMIT -> v_over = 1 :: else -> skip fi;
+              if :: x >= 7 -> v_big = 1 :: else -> skip fi }
+  od
+}
+// @property P_BELOW REQ-TG-008 : the counter stays below MODEL_LIMIT
+ltl P_BELOW { [] !v_over }
+// @property P_SMALL REQ-TG-008 : the counter stays below 7
+ltl P_SMALL { [] (x < 7 && !v_big) }
+"""
+
+
+def _two(tmp_path, wrap):
+    model = tmp_path / "two.pml"
+    model.write_text(TWO_INVARIANTS)
+    params = tmp_path / "params"
+    params.mkdir()
+    (params / "two_params.pml").write_text(f"#define MODEL_WRAP {wrap}\n#define MODEL_LIMIT 5\n")
+    return model, params
+
+
+def test_invariant_claims_and_their_conjunction():
+    claims = spin.invariant_claims(TWO_INVARIANTS + "ltl LIVE { <> x == 3 }\n")
+    assert claims == {"P_BELOW": "!v_over", "P_SMALL": "(x < 7 && !v_big)"}
+    assert spin.combined_claim(list(claims.values())) == \
+        "ltl railproof_all { [] ((!v_over) && ((x < 7 && !v_big))) }\n"
+
+
+@needs_spin
+def test_properties_of_a_configuration_are_verified_in_one_search(tmp_path):
+    import subprocess
+    model, params = _two(tmp_path, wrap=4)
+    res = spin.verify(model, params, tmp_path / "work", tmp_path / "out.json", jobs=1)
+    below, small = res["properties"]
+    assert below["verdict"] == small["verdict"] == "verified"
+    assert below["verified_with"] == ["P_SMALL"] and small["verified_with"] == ["P_BELOW"]
+    assert below["command"] == small["command"] and below["command"].endswith("./pan -N railproof_all")
+    assert below["states_stored"] == small["states_stored"] > 0
+    # the recorded command replays the combined search from the model alone
+    replay = tmp_path / "replay"
+    replay.mkdir()
+    shutil.copy2(model, replay)
+    shutil.copy2(params / "two_params.pml", replay)
+    r = subprocess.run(["bash", "-c", below["command"]], cwd=replay, capture_output=True, text=True)
+    assert r.returncode == 0 and "errors: 0" in r.stdout, r.stdout + r.stderr
+
+
+@needs_spin
+def test_a_violation_found_together_is_reported_against_its_property(tmp_path):
+    model, params = _two(tmp_path, wrap=6)  # the counter reaches 5: P_BELOW fails, P_SMALL holds
+    with pytest.raises(PipelineError) as exc:
+        spin.verify(model, params, tmp_path / "work", tmp_path / "out.json", jobs=2)
+    assert "P_BELOW (REQ-TG-008) [default] violated" in str(exc.value)
+    assert "P_SMALL" not in str(exc.value)
+    import json
+    below, small = json.loads((tmp_path / "out.json").read_text())["properties"]
+    assert below["verdict"] == "violated" and "@OUT tx seq=5" in below["counterexample"]
+    assert small["verdict"] == "verified" and small["command"].endswith("./pan -N P_SMALL")
+    assert "verified_with" not in small
