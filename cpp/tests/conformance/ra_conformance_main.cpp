@@ -263,17 +263,11 @@ int main(int argc, char** argv) {
   }
   std::string error;
   const bool ok = Load(args.vectors_dir, error);
-  const std::size_t n = ok ? g_vectors.size() : 0;
-  testing::RegisterTest("ReadhesionConformance", "VectorSet", nullptr, nullptr, __FILE__, __LINE__,
-                        [error, nfiles = g_files.size(), n]() -> testing::Test* {
-                          return new rcli::VectorSetTest(error, nfiles, n);
-                        });
-  for (std::size_t i = 0; i < n; ++i) {
-    const Vector& v = g_vectors[i];
-    testing::RegisterTest("ReadhesionConformance", v.test_name.c_str(), nullptr, nullptr, v.file.c_str(),
-                          static_cast<int>(v.line), [i]() -> testing::Test* { return new VectorTest(i); });
-  }
-  rcli::ReportLoad("railproof-conformance-ra", ok, error, n, g_files.size(), args.vectors_dir);
-  const int rc_tests = RUN_ALL_TESTS();
-  return rcli::Finish("railproof-conformance-ra", ok, error, g_mismatched.load(), g_replayed.load(), n, rc_tests);
+  return rcli::RunVectorTests(
+      "railproof-conformance-ra", "ReadhesionConformance", args, ok, error, ok ? g_vectors.size() : 0, g_files.size(),
+      [](std::size_t i) {
+        const Vector& v = g_vectors[i];
+        return rcli::VectorSite{v.test_name, v.file, static_cast<int>(v.line)};
+      },
+      [](std::size_t i) -> testing::Test* { return new VectorTest(i); }, g_mismatched, g_replayed);
 }

@@ -1,5 +1,5 @@
-// Command line and exit protocol shared by the conformance runners
-// (railproof_conformance, railproof_conformance_mb, railproof_conformance_br):
+// Command line, test registration and exit protocol shared by the conformance runners
+// (railproof_conformance, _mb, _br, _ra, _lc):
 //   <runner> --vectors DIR [--junit FILE] [--gtest_* flags]
 // Exit status 0 if every vector passed, 1 if not (or no usable vector set), 2 on bad
 // arguments. The last line printed is one of
@@ -10,9 +10,11 @@
 
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <cstddef>
 #include <cstdio>
 #include <cstring>
+#include <functional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -122,6 +124,33 @@ inline int Finish(const char* prog, bool ok, const std::string& error, std::size
   }
   std::printf("%s: all %zu vectors passed (%zu in the set)\n", prog, replayed, in_set);
   return 0;
+}
+
+// Where a vector's test is reported: its GoogleTest name and the file and line of the vector.
+struct VectorSite {
+  std::string test_name;
+  std::string file;
+  int line = 0;
+};
+
+// Registers the VectorSet test and one test per loaded vector (suite `suite`), prints the
+// load result, runs the tests and applies the exit protocol. site(i) names vector i's test,
+// make_test(i) creates it; n is the number of vectors loaded (0 if the load failed).
+inline int RunVectorTests(const char* prog, const char* suite, const RunnerArgs& args, bool ok,
+                          const std::string& error, std::size_t n, std::size_t files,
+                          const std::function<VectorSite(std::size_t)>& site,
+                          const std::function<testing::Test*(std::size_t)>& make_test,
+                          const std::atomic<std::size_t>& mismatched, const std::atomic<std::size_t>& replayed) {
+  testing::RegisterTest(suite, "VectorSet", nullptr, nullptr, __FILE__, __LINE__,
+                        [error, files, n]() -> testing::Test* { return new VectorSetTest(error, files, n); });
+  for (std::size_t i = 0; i < n; ++i) {
+    const VectorSite at = site(i);
+    testing::RegisterTest(suite, at.test_name.c_str(), nullptr, nullptr, at.file.c_str(), at.line,
+                          [make_test, i]() -> testing::Test* { return make_test(i); });
+  }
+  ReportLoad(prog, ok, error, n, files, args.vectors_dir);
+  const int rc_tests = RUN_ALL_TESTS();
+  return Finish(prog, ok, error, mismatched.load(), replayed.load(), n, rc_tests);
 }
 
 }  // namespace railproof::conformance
