@@ -31,7 +31,6 @@ spec/justifications.
 """
 from __future__ import annotations
 
-import json
 import math
 import re
 import shutil
@@ -41,8 +40,7 @@ from pathlib import Path
 from . import __version__
 from . import spin as spin_mod
 from .errors import PipelineError, SpecError
-from .vectors import _atomic_write, _progress, load_justifications, schema_checked_jsonl, search_goal, \
-    write_goals_file
+from .vectors import _progress, load_justifications, search_goal, write_configuration_files, write_goals_file
 from .vectors import model_bounds as _bounds
 
 TICK_MS = 10_000
@@ -536,11 +534,6 @@ def _vid(kind: str, config, tail: str) -> str:
     return f"LC-{kind.upper()}-{CONFIGS[config][1]}{tail}"
 
 
-def _order(vid: str):
-    m = re.search(r"(\d+)$", vid)
-    return (vid[: m.start()] if m else vid, int(m.group(1)) if m else 0)
-
-
 def generate(model: Path, params_dir: Path, spec_dir: Path, workdir: Path, out_dir: Path,
              walks: int = 50, jobs: int = 2):
     model = Path(model)
@@ -628,33 +621,7 @@ def generate(model: Path, params_dir: Path, spec_dir: Path, workdir: Path, out_d
         per_config[cfg].append({"id": _vid("random", cfg, f"S{seed}"),
                                 "requirements": sorted(observed_requirements(steps)),
                                 "goal": None, "kind": "random", "seed": seed, "steps": steps})
-    for vecs in per_config.values():
-        vecs.sort(key=lambda v: (v["kind"] == "random", v["kind"] == "trap", _order(v["id"])))
-
-    out_dir = Path(out_dir)
-    out_dir.mkdir(parents=True, exist_ok=True)
-    schema = Path(spec_dir) / "schemas" / "vectors_level_crossing.schema.json"
-    texts = {}
-    for cfg, vecs in per_config.items():
-        name = f"{model.stem}{CONFIGS[cfg][0]}.jsonl"
-        texts[name] = schema_checked_jsonl(schema, [header_for(model, b, cfg), *vecs], name)
-    all_vecs = [v for vecs in per_config.values() for v in vecs]
-    cov_goals = [coverage[g.gid] for g in ann.goals]
-    reached = sum(1 for c in cov_goals if c["status"] == "reached")
-    cov = {"schema": "railproof/coverage/1", "model": model_rel, "goals": cov_goals, "reached": reached,
-           "labelled": len(cov_goals), "unreachable_justified": sum(
-               1 for c in cov_goals if c["status"] == "unreachable" and c["justification"]),
-           "vectors": {k: sum(v["kind"] == k for v in all_vecs) for k in ("trap", "boundary", "random")},
-           "files": {f"{model.stem}{CONFIGS[c][0]}.jsonl": len(v) for c, v in per_config.items()}}
-    for old in out_dir.glob(f"{model.stem}.*.jsonl"):
-        if old.name not in texts:
-            old.unlink()  # a file of an earlier configuration set
-    for name, text in texts.items():
-        _atomic_write(out_dir / name, text)
-    _atomic_write(out_dir / f"{model.stem}.coverage.json", json.dumps(cov, indent=2, sort_keys=True) + "\n")
-    _progress(f"goal coverage {reached}/{len(cov_goals)} reached, {cov['unreachable_justified']} "
-              f"unreachable justified; {len(all_vecs)} vectors written "
-              f"({', '.join(f'{n}: {k}' for n, k in cov['files'].items())})")
-    if problems:
-        raise PipelineError(f"{model.name}: " + "; ".join(problems))
-    return cov
+    return write_configuration_files(model, model_rel, ann, coverage, per_config,
+                                     {c: v[0] for c, v in CONFIGS.items()},
+                                     lambda cfg: header_for(model, b, cfg),
+                                     Path(spec_dir) / "schemas" / "vectors_level_crossing.schema.json", out_dir, problems)

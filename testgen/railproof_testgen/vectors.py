@@ -384,6 +384,51 @@ def _atomic_write(path: Path, text: str):
     tmp.replace(path)
 
 
+def _id_order(vid: str):
+    """Sort key: numeric part of G<k> / S<seed> ids."""
+    m = re.search(r"(\d+)$", vid)
+    return (vid[: m.start()] if m else vid, int(m.group(1)) if m else 0)
+
+
+def write_configuration_files(model: Path, model_rel: str, ann, coverage: dict, per_config: dict,
+                              suffixes: dict, header_for, schema: Path, out_dir: Path,
+                              problems: list) -> dict:
+    """The shared end of the generators that write one vector file per model configuration
+    (readhesion, level crossing): sort each file's vectors (boundary, trap, random; by goal
+    or seed), check every line against the schema before anything is written, write the
+    files and the coverage record atomically, remove the files of configurations no longer
+    generated, and fail with the collected problems. suffixes: configuration -> file-name
+    suffix; header_for(configuration) -> the file's header line."""
+    for vecs in per_config.values():
+        vecs.sort(key=lambda v: (v["kind"] == "random", v["kind"] == "trap", _id_order(v["id"])))
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    texts = {}
+    for cfg, vecs in per_config.items():
+        name = f"{model.stem}{suffixes[cfg]}.jsonl"
+        texts[name] = schema_checked_jsonl(schema, [header_for(cfg), *vecs], name)
+    all_vecs = [v for vecs in per_config.values() for v in vecs]
+    cov_goals = [coverage[g.gid] for g in ann.goals]
+    reached = sum(1 for c in cov_goals if c["status"] == "reached")
+    cov = {"schema": "railproof/coverage/1", "model": model_rel, "goals": cov_goals, "reached": reached,
+           "labelled": len(cov_goals), "unreachable_justified": sum(
+               1 for c in cov_goals if c["status"] == "unreachable" and c["justification"]),
+           "vectors": {k: sum(v["kind"] == k for v in all_vecs) for k in ("trap", "boundary", "random")},
+           "files": {f"{model.stem}{suffixes[c]}.jsonl": len(v) for c, v in per_config.items()}}
+    for old in out_dir.glob(f"{model.stem}.*.jsonl"):
+        if old.name not in texts:
+            old.unlink()  # a file of an earlier configuration set
+    for name, text in texts.items():
+        _atomic_write(out_dir / name, text)
+    _atomic_write(out_dir / f"{model.stem}.coverage.json", json.dumps(cov, indent=2, sort_keys=True) + "\n")
+    _progress(f"goal coverage {reached}/{len(cov_goals)} reached, {cov['unreachable_justified']} "
+              f"unreachable justified; {len(all_vecs)} vectors written "
+              f"({', '.join(f'{n}: {k}' for n, k in cov['files'].items())})")
+    if problems:
+        raise PipelineError(f"{model.name}: " + "; ".join(problems))
+    return cov
+
+
 def register(sub):
     p = sub.add_parser("vectors", help="derive conformance vectors (trap goals, boundaries, random walks)")
     p.add_argument("--model", required=True)
