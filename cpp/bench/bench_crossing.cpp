@@ -113,7 +113,7 @@ void BM_CentreCycle(benchmark::State& state) {
     railproof::wayside::SchedulerInput in;
     in.now_ms = now;
     in.restrictions = r;
-    in.position = railproof::wayside::PositionReport{1, now, kOrigin - 500'000, kOrigin - 700'000, (now / 100 % 64) * 300};
+    in.position = railproof::wayside::CentrePositionReport{1, now, kOrigin - 500'000, kOrigin - 700'000, (now / 100 % 64) * 300};
     benchmark::DoNotOptimize(s.Cycle(in));
     now += 100;
   }

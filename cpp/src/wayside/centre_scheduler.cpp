@@ -175,7 +175,7 @@ SchedulerError CentreScheduler::Cycle(const SchedulerInput& in) noexcept {
   } else if (onboard::EarliestArrivalMs(0, 0, 0, 0, in.restrictions).error != onboard::EtaError::kNone) {
     error = SchedulerError::kProfileInvalid;
   } else if (in.position.has_value() && in.position->train_id == departure_->train_id) {
-    const PositionReport& p = *in.position;
+    const CentrePositionReport& p = *in.position;
     if (!ClockOk(p.time_ms)) {
       error = SchedulerError::kTimeInvalid;
     } else if (!PositionOk(p.front_mm) || !PositionOk(p.rear_mm) || p.rear_mm > p.front_mm) {
@@ -232,7 +232,7 @@ SchedulerError CentreScheduler::Cycle(const SchedulerInput& in) noexcept {
   }
   // 3. Position report: tracking plausibility, passage, recomputation (REQ-LC-010, REQ-LC-012).
   if (in.position.has_value()) {
-    const PositionReport& p = *in.position;
+    const CentrePositionReport& p = *in.position;
     if (p.train_id != dep.train_id) {
       ++ignored;
     } else if (p.front_mm < tracked_front_mm_ || p.time_ms > now) {

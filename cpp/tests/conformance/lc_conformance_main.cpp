@@ -604,7 +604,7 @@ void ReplayGnss(const Vector& v, std::vector<std::string>& problems) {
     si.reports = reports;
     si.restrictions = cfg.restrictions;
     if (const json& p = in.at("position"); !p.is_null()) {
-      si.position = ws::PositionReport{static_cast<std::uint32_t>(I(p, "train_id")), I(p, "time_ms"), I(p, "front_mm"),
+      si.position = ws::CentrePositionReport{static_cast<std::uint32_t>(I(p, "train_id")), I(p, "time_ms"), I(p, "front_mm"),
                                        I(p, "rear_mm"), I(p, "speed_mm_s")};
     }
     {

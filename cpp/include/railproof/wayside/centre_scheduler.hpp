@@ -62,7 +62,9 @@ struct Departure {
 // rear_min, an upper bound of the speed, and the time the position was taken (the train's
 // GNSS time). The start times are recomputed from time_ms, not from the reception time (the
 // train may have moved since: the report time is the safe reading of design §5 step 4 "now").
-struct PositionReport {
+// Named apart from the moving-block ground's wayside::PositionReport (ground.hpp): one name
+// with two layouts in one namespace breaks the One Definition Rule (UBSan found it).
+struct CentrePositionReport {
   std::uint32_t train_id = 0;
   std::int64_t time_ms = 0;
   std::int64_t front_mm = 0;  // front_max
@@ -136,7 +138,7 @@ struct SchedulerInput {
   std::span<const StartTimeAck> start_acks;
   std::span<const WarningStopAck> stop_acks;
   std::span<const CrossingReport> reports;
-  std::optional<PositionReport> position;
+  std::optional<CentrePositionReport> position;
   std::span<const braking::RestrictionSegment> restrictions;
 };
 

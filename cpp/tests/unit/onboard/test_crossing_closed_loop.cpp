@@ -250,7 +250,7 @@ LoopResult GnssLoop(std::int64_t late_ms, bool clock_fault) {
     }
     si.restrictions = kProfile;
     if (now % params::level_crossing::position_report_ms == 0) {
-      si.position = wayside::PositionReport{kTrain, now, train.FrontMax(), train.RearMin(), train.v};
+      si.position = wayside::CentrePositionReport{kTrain, now, train.FrontMax(), train.RearMin(), train.v};
     }
     EXPECT_EQ(s.Cycle(si), wayside::SchedulerError::kNone);
 

@@ -159,7 +159,7 @@ TEST(LcCentreScheduler, LaterStartTimesFromPositionReports) {
   CentreScheduler s = Acked();
   // departed at 105 s from rest: at 110 s it runs 2.5 m/s at 6.25 m
   SchedulerInput in = At(110'200);
-  in.position = PositionReport{kTrain, 110'000, 6'250, 0, 2'500};
+  in.position = CentrePositionReport{kTrain, 110'000, 6'250, 0, 2'500};
   ASSERT_EQ(s.Cycle(in), SchedulerError::kNone);
   EXPECT_EQ(s.Find(1)->start_ms, kSt1 + 5'000);
   EXPECT_EQ(s.Find(2)->start_ms, kSt2 + 5'000);
@@ -183,7 +183,7 @@ TEST(LcCentreScheduler, LaterStartTimesFromPositionReports) {
 TEST(LcCentreScheduler, StandingBeforeDepartureChangesNothing) {
   CentreScheduler s = Acked();
   SchedulerInput in = At(50'000);
-  in.position = PositionReport{kTrain, 50'000, 0, -100'000, 0};
+  in.position = CentrePositionReport{kTrain, 50'000, 0, -100'000, 0};
   ASSERT_EQ(s.Cycle(in), SchedulerError::kNone);
   EXPECT_EQ(s.Find(1)->start_ms, kSt1);
   EXPECT_EQ(s.Find(2)->start_ms, kSt2);
@@ -196,7 +196,7 @@ TEST(LcCentreScheduler, StandingBeforeDepartureChangesNothing) {
 TEST(LcCentreScheduler, EarlierRecomputationIsSentToo) {
   CentreScheduler s = Acked();
   SchedulerInput in = At(110'000);
-  in.position = PositionReport{kTrain, 110'000, 50'000, -50'000, 10'000};
+  in.position = CentrePositionReport{kTrain, 110'000, 50'000, -50'000, 10'000};
   ASSERT_EQ(s.Cycle(in), SchedulerError::kNone);
   // ETA from 50 m at 10 m/s: 20 s to 20 m/s over 300 m, 650 m cruising: 52.5 s
   EXPECT_EQ(s.Find(1)->start_ms, 110'000 + 52'500 - 30'000 - kAllowance);
@@ -208,12 +208,12 @@ TEST(LcCentreScheduler, EarlierRecomputationIsSentToo) {
 TEST(LcCentreScheduler, WarningStopAfterAPlausiblePassageUntilAcknowledged) {
   CentreScheduler s = Acked();
   SchedulerInput in = At(200'000);
-  in.position = PositionReport{kTrain, 199'000, 1'106'000, 1'005'999, 20'000};  // rear 1 mm short
+  in.position = CentrePositionReport{kTrain, 199'000, 1'106'000, 1'005'999, 20'000};  // rear 1 mm short
   ASSERT_EQ(s.Cycle(in), SchedulerError::kNone);
   EXPECT_FALSE(s.Find(1)->passed);
   EXPECT_TRUE(s.Output().WarningStops().empty());
   in = At(205'000);
-  in.position = PositionReport{kTrain, 204'500, 1'106'000, 1'006'000, 20'000};  // rear at far
+  in.position = CentrePositionReport{kTrain, 204'500, 1'106'000, 1'006'000, 20'000};  // rear at far
   ASSERT_EQ(s.Cycle(in), SchedulerError::kNone);
   EXPECT_TRUE(s.Find(1)->passed);
   ASSERT_EQ(s.Output().WarningStops().size(), 1U);
@@ -239,18 +239,18 @@ TEST(LcCentreScheduler, WarningStopAfterAPlausiblePassageUntilAcknowledged) {
 TEST(LcCentreScheduler, ImplausibleReportGivesNoWarningStop) {
   CentreScheduler s = Acked();
   SchedulerInput in = At(200'000);
-  in.position = PositionReport{kTrain, 200'000, 900'000, 800'000, 20'000};
+  in.position = CentrePositionReport{kTrain, 200'000, 900'000, 800'000, 20'000};
   ASSERT_EQ(s.Cycle(in), SchedulerError::kNone);
   EXPECT_EQ(s.TrackedFrontMm(), 900'000);
   in = At(201'000);
-  in.position = PositionReport{kTrain, 201'000, 899'999, 899'999 - 1, 20'000};
+  in.position = CentrePositionReport{kTrain, 201'000, 899'999, 899'999 - 1, 20'000};
   ASSERT_EQ(s.Cycle(in), SchedulerError::kNone);
   EXPECT_TRUE(s.Output().report_rejected);
   // a report claiming the passage with its front behind the tracked front
   in = At(202'000);
-  in.position = PositionReport{kTrain, 202'000, 899'000, 899'000, 20'000};
+  in.position = CentrePositionReport{kTrain, 202'000, 899'000, 899'000, 20'000};
   ASSERT_EQ(s.Cycle(in), SchedulerError::kNone);
-  in.position = PositionReport{kTrain, 202'000, 1'200'000 - 1, 1'100'000, 20'000};
+  in.position = CentrePositionReport{kTrain, 202'000, 1'200'000 - 1, 1'100'000, 20'000};
   in.now_ms = 202'000;
   // time in the future: rejected as well
   in.position->time_ms = 202'001;
@@ -260,7 +260,7 @@ TEST(LcCentreScheduler, ImplausibleReportGivesNoWarningStop) {
   EXPECT_TRUE(s.Output().WarningStops().empty());
   EXPECT_EQ(s.TrackedFrontMm(), 900'000);
   // a report of another train is ignored
-  in.position = PositionReport{kTrain + 1, 202'000, 1'200'000, 1'100'000, 20'000};
+  in.position = CentrePositionReport{kTrain + 1, 202'000, 1'200'000, 1'100'000, 20'000};
   ASSERT_EQ(s.Cycle(in), SchedulerError::kNone);
   EXPECT_EQ(s.Output().ignored_messages, 1U);
   EXPECT_FALSE(s.Find(1)->passed);
@@ -285,9 +285,9 @@ TEST(LcCentreScheduler, TypedErrors) {
   ASSERT_EQ(s.StartDeparture({kTrain, kDep, kTdep, 0}, kCrossings, kProfile, 1'000), SchedulerError::kNone);
   EXPECT_EQ(s.Cycle(At(999)), SchedulerError::kTimeWentBack);
   SchedulerInput in = At(1'000);
-  in.position = PositionReport{kTrain, 1'000, 0, 1, 0};  // rear ahead of front
+  in.position = CentrePositionReport{kTrain, 1'000, 0, 1, 0};  // rear ahead of front
   EXPECT_EQ(s.Cycle(in), SchedulerError::kPositionInvalid);
-  in.position = PositionReport{kTrain, 1'000, 10, 0, -5};
+  in.position = CentrePositionReport{kTrain, 1'000, 10, 0, -5};
   EXPECT_EQ(s.Cycle(in), SchedulerError::kSpeedInvalid);
   std::vector<StartTimeAck> flood(kMaxSchedulerMessages + 1);
   in = At(1'000);
@@ -317,7 +317,7 @@ std::vector<std::int64_t> RunDeparture(CentreScheduler& s) {
     }
     in.stop_acks = std::span<const WarningStopAck>(stops.data(), m);
     if (now % 5'000 == 0) {
-      in.position = PositionReport{kTrain, now, front, front - 80'000, v};
+      in.position = CentrePositionReport{kTrain, now, front, front - 80'000, v};
     }
     EXPECT_EQ(s.Cycle(in), SchedulerError::kNone);
     if (s.Output().departure_cleared || v > 0) {
@@ -353,7 +353,7 @@ TEST(LcCentreScheduler, NoHeapInTheCycle) {
   std::int64_t sum = 0;
   for (std::int64_t k = 0; k < 200; ++k) {
     SchedulerInput in = At(2'000 + k * 500);
-    in.position = PositionReport{kTrain, 2'000 + k * 500, k * 1'000, k * 1'000 - 80'000, 5'000};
+    in.position = CentrePositionReport{kTrain, 2'000 + k * 500, k * 1'000, k * 1'000 - 80'000, 5'000};
     sum += static_cast<std::int64_t>(s.Cycle(in));
     sum += s.Find(1)->start_ms;
   }
