@@ -5,14 +5,18 @@
 set(RAILPROOF_GEN_INCLUDE ${RAILPROOF_GEN_DIR}/include)
 file(MAKE_DIRECTORY ${RAILPROOF_GEN_INCLUDE}/railproof/generated ${RAILPROOF_GEN_DIR}/models)
 file(GLOB RAILPROOF_SPEC_FILES CONFIGURE_DEPENDS
-  ${RAILPROOF_SOURCE_DIR}/spec/*/*.yaml ${RAILPROOF_SOURCE_DIR}/spec/schemas/*.json)
-file(GLOB RAILPROOF_TESTGEN_FILES CONFIGURE_DEPENDS ${RAILPROOF_SOURCE_DIR}/testgen/railproof_testgen/*.py)
+  ${RAILPROOF_SOURCE_DIR}/spec/*.yaml ${RAILPROOF_SOURCE_DIR}/spec/*/*.yaml ${RAILPROOF_SOURCE_DIR}/spec/schemas/*.json)
+# The spec steps depend on the testgen modules they run, not on all of testgen: a change to
+# the evidence code does not regenerate the parameter headers (and re-verify every model).
+set(_tgm ${RAILPROOF_SOURCE_DIR}/testgen/railproof_testgen)
+set(RAILPROOF_SPEC_TOOL_FILES ${_tgm}/__init__.py ${_tgm}/__main__.py ${_tgm}/errors.py ${_tgm}/spec.py
+    ${_tgm}/validate.py ${_tgm}/lines.py ${_tgm}/trains.py ${_tgm}/params.py)
 # One C++ header and one Promela header per parameter file, named after the file
 # (spec/parameters/<name>.yaml -> <name>_params.hpp / .pml; gen-params checks the name).
-file(GLOB _param_files CONFIGURE_DEPENDS ${RAILPROOF_SOURCE_DIR}/spec/parameters/*.yaml)
+file(GLOB RAILPROOF_PARAM_FILES CONFIGURE_DEPENDS ${RAILPROOF_SOURCE_DIR}/spec/parameters/*.yaml)
 set(RAILPROOF_PARAM_HEADER)
 set(RAILPROOF_PARAM_PML)
-foreach(f ${_param_files})
+foreach(f ${RAILPROOF_PARAM_FILES})
   get_filename_component(n ${f} NAME_WE)
   list(APPEND RAILPROOF_PARAM_HEADER ${RAILPROOF_GEN_INCLUDE}/railproof/generated/${n}_params.hpp)
   list(APPEND RAILPROOF_PARAM_PML ${RAILPROOF_GEN_DIR}/models/${n}_params.pml)
@@ -20,7 +24,7 @@ endforeach()
 add_custom_command(
   OUTPUT ${RAILPROOF_PARAM_HEADER} ${RAILPROOF_PARAM_PML}
   COMMAND ${RAILPROOF_TESTGEN} gen-params --spec ${RAILPROOF_SOURCE_DIR}/spec --out ${RAILPROOF_GEN_DIR}
-  DEPENDS ${RAILPROOF_SPEC_FILES} ${RAILPROOF_TESTGEN_FILES}
+  DEPENDS ${RAILPROOF_SPEC_FILES} ${RAILPROOF_SPEC_TOOL_FILES}
   COMMENT "spec: validating spec/ and generating parameter headers"
   VERBATIM)
 add_custom_target(railproof_gen_params DEPENDS ${RAILPROOF_PARAM_HEADER} ${RAILPROOF_PARAM_PML})
@@ -36,7 +40,7 @@ endforeach()
 add_custom_command(
   OUTPUT ${RAILPROOF_LINE_JSON}
   COMMAND ${RAILPROOF_TESTGEN} lines --spec ${RAILPROOF_SOURCE_DIR}/spec --out ${RAILPROOF_GEN_DIR}/lines
-  DEPENDS ${RAILPROOF_LINE_FILES} ${RAILPROOF_SPEC_FILES} ${RAILPROOF_TESTGEN_FILES}
+  DEPENDS ${RAILPROOF_LINE_FILES} ${RAILPROOF_SPEC_FILES} ${RAILPROOF_SPEC_TOOL_FILES}
   COMMENT "spec: validating spec/lines and writing the line JSON"
   VERBATIM)
 add_custom_target(railproof_gen_lines ALL DEPENDS ${RAILPROOF_LINE_JSON})
@@ -59,7 +63,7 @@ endforeach()
 add_custom_command(
   OUTPUT ${RAILPROOF_TRAIN_JSON} ${RAILPROOF_TRAIN_MUTANT_JSON}
   COMMAND ${RAILPROOF_TESTGEN} trains --spec ${RAILPROOF_SOURCE_DIR}/spec --out ${RAILPROOF_GEN_DIR}/trains
-  DEPENDS ${RAILPROOF_TRAIN_FILES} ${RAILPROOF_TRAIN_MUTANT_FILES} ${RAILPROOF_SPEC_FILES} ${RAILPROOF_TESTGEN_FILES}
+  DEPENDS ${RAILPROOF_TRAIN_FILES} ${RAILPROOF_TRAIN_MUTANT_FILES} ${RAILPROOF_SPEC_FILES} ${RAILPROOF_SPEC_TOOL_FILES}
   COMMENT "spec: validating spec/trains and writing the train JSON"
   VERBATIM)
 add_custom_target(railproof_gen_trains ALL DEPENDS ${RAILPROOF_TRAIN_JSON} ${RAILPROOF_TRAIN_MUTANT_JSON})

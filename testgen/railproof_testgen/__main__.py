@@ -11,7 +11,7 @@ import sys
 
 from .errors import PipelineError, SpecError
 
-COMMAND_MODULES = ["params", "validate", "lines", "trace", "spin", "vectors", "evidence",
+COMMAND_MODULES = ["registry", "layout", "params", "validate", "lines", "trace", "spin", "vectors", "evidence",
                    "toolversions", "trains", "proofs"]
 
 

@@ -1,4 +1,4 @@
-"""Conformance vectors of models/braking.pml (spec/design/braking.md §4, the supervision
+"""Conformance vectors of models/br.pml (spec/design/br.md §4, the supervision
 decision: brake-level selection, emergency-brake latch and release).
 
 Same technique as the telegram and moving-block vectors (vectors.py, mb_vectors.py): one
@@ -7,9 +7,9 @@ goals whose label names a boundary are the boundary vectors (v_s exactly at and 
 a pattern speed); then seeded random walks of MODEL_CYCLES cycles (configuration WALK).
 
 Units: the model's speeds are abstract integers 0..MODEL_VMAX; the vectors carry them
-unchanged and the conformance harness feeds them to braking::Supervisor as mm/s. This is
+unchanged and the conformance harness feeds them to br::Supervisor as mm/s. This is
 exact because the decision only compares the supervised speed with the pattern speeds
-(header "units"). One file, braking.jsonl (schema spec/schemas/vectors_braking.schema.json),
+(header "units"). One file, braking.jsonl (schema spec/schemas/vectors_br.schema.json),
 checked line by line before it is written, and braking.coverage.json.
 A goal that the exhaustive search cannot reach must be justified in spec/justifications.
 """
@@ -28,9 +28,9 @@ from .vectors import _atomic_write, _progress, load_justifications, schema_check
     write_goals_file
 from .vectors import model_bounds as _bounds
 
-# braking::BrakeLevel in order, named as braking::ToString
+# br::BrakeLevel in order, named as br::ToString
 LEVELS = ["NONE", "4N", "5N", "6N", "7N", "EB"]
-# the model's pattern speeds p0..p5 in the order of braking::PatternSpeeds
+# the model's pattern speeds p0..p5 in the order of br::PatternSpeeds
 PATTERNS = ["v_e", "v_7n", "v_6n", "v_5n", "v_4n", "v_release"]
 BOUNDARY_WORDS = ("boundary",)
 UNITS = "abstract speed units = mm/s"
@@ -69,7 +69,7 @@ def parse_events(text: str):
 
 
 def to_steps(events):
-    """Raw cycles -> vector steps (spec/schemas/vectors_braking.schema.json)."""
+    """Raw cycles -> vector steps (spec/schemas/vectors_br.schema.json)."""
     steps = []
     for i, o in events:
         if o["level"] >= len(LEVELS):
@@ -112,7 +112,7 @@ def generate(model: Path, params_dir: Path, spec_dir: Path, workdir: Path, out_d
     for key in ("vmax", "cycles"):
         if key not in b:
             raise SpecError(Path(params_dir) / f"{model.stem}_params.pml", f"MODEL_{key.upper()}",
-                            "model bound missing (spec/parameters/braking.yaml model_bounds)")
+                            "model bound missing (spec/parameters/br.yaml model_bounds)")
     workdir = Path(workdir)
     workdir.mkdir(parents=True, exist_ok=True)
     goals_file = workdir / f"{model.stem}_goals.pml"
@@ -180,7 +180,7 @@ def generate(model: Path, params_dir: Path, spec_dir: Path, workdir: Path, out_d
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     name = f"{model.stem}.jsonl"
-    schema = Path(spec_dir) / "schemas" / "vectors_braking.schema.json"
+    schema = Path(spec_dir) / "schemas" / "vectors_br.schema.json"
     text = schema_checked_jsonl(schema, [header_for(model, b), *vectors], name)
     reached = sum(1 for c in coverage if c["status"] == "reached")
     cov = {"schema": "railproof/coverage/1", "model": model_rel, "goals": coverage, "reached": reached,

@@ -4,7 +4,7 @@
 
 1. reads spec/ (requirements, hazards, assumptions, parameters) and the pipeline's result
    files (spin/*.json, vectors/*.jsonl + *.coverage.json, tests/**/*.xml, analysis/*.json,
-   trace.json; formats: spec/design/telegram-layer.md §8) plus optional tool versions;
+   trace.json; formats: spec/design/tg.md §8) plus optional tool versions;
 2. copies every input verbatim to OUT/inputs, copies the Sphinx sources of REPO/evidence to
    OUT/src and writes the generated reStructuredText pages beside them (rendered from the
    Jinja templates in evidence/templates): one sphinx-needs need per requirement, hazard,
@@ -58,8 +58,8 @@ EXCLUDED = {
     "**/__pycache__/": "Python byte code (not written: PYTHONDONTWRITEBYTECODE=1)",
 }
 
-# Verification configurations of models/moving_block.pml (its header comment and
-# spec/design/moving-block.md §5), in the order the chapter lists them.
+# Verification configurations of models/mb.pml (its header comment and
+# spec/design/mb.md §5), in the order the chapter lists them.
 MB_CONFIGURATIONS = {
     "default": "the full model: every train of the model bounds and every environment command "
                "(possession, siding route, radio cells, boundary) with every fault",
@@ -595,7 +595,7 @@ def _load_chapter_plots(inp: Inputs, subdir: str, plots: list) -> None:
         inp.files.append(InputFile(f, f"results/{rel}"))
 
 
-PEER_CHECK_NOTE = "design/level-crossing.md"
+PEER_CHECK_NOTE = "design/lc.md"
 ID_TOKEN = re.compile(r"\b(?:REQ|HAZ|ASM)-[A-Z0-9]+(?:-[0-9]+)?\b")
 
 

@@ -1,4 +1,4 @@
-"""Conformance vectors of models/level_crossing.pml (spec/design/level-crossing.md §3-§6: the
+"""Conformance vectors of models/lc.pml (spec/design/lc.md §3-§6: the
 on-board crossing function, the crossing controllers and the centre scheduler).
 
 Same technique as the braking and re-adhesion vectors (br_vectors.py, ra_vectors.py): one
@@ -25,7 +25,7 @@ is checked against an exact re-computation of the C++ rounding (EarliestArrivalM
 design, one profile piece) for every value that occurs: the tick length is valid only if
 floor(E * TICK_MS) keeps the class, which the generator asserts.
 
-Every line is checked against spec/schemas/vectors_level_crossing.schema.json before the files
+Every line is checked against spec/schemas/vectors_lc.schema.json before the files
 are written. A goal that the exhaustive search cannot reach must be justified in
 spec/justifications.
 """
@@ -73,7 +73,7 @@ CONFIGS = {
     "GNSS": (".gnss", "GNSS-", "GNSS", 0),
     "GNSS_CLOCK": (".gnss_clock", "GNSSCLOCK-", "GNSS", 0),
 }
-# model bounds of spec/parameters/level_crossing.yaml, and the model-local ones (defaults in the
+# model bounds of spec/parameters/lc.yaml, and the model-local ones (defaults in the
 # model, overridden by the parameters file once they are there)
 BOUNDS = ("track", "vmax", "lc_a", "lc_b", "train_len", "station", "warn_ticks", "lower_ticks", "max_delay",
           "cycles")
@@ -174,7 +174,7 @@ def all_bounds(model: Path, params_pml: Path) -> dict:
     for key in BOUNDS:
         if key not in b:
             raise SpecError(params_pml, f"MODEL_{key.upper()}",
-                            "model bound missing (spec/parameters/level_crossing.yaml model_bounds)")
+                            "model bound missing (spec/parameters/lc.yaml model_bounds)")
     local = model_local_defaults(model)
     local.setdefault("dwell_ticks", local.get("lead_ticks", 0) + 1)  # the model's default expression
     for key in LOCAL:
@@ -624,4 +624,4 @@ def generate(model: Path, params_dir: Path, spec_dir: Path, workdir: Path, out_d
     return write_configuration_files(model, model_rel, ann, coverage, per_config,
                                      {c: v[0] for c, v in CONFIGS.items()},
                                      lambda cfg: header_for(model, b, cfg),
-                                     Path(spec_dir) / "schemas" / "vectors_level_crossing.schema.json", out_dir, problems)
+                                     Path(spec_dir) / "schemas" / "vectors_lc.schema.json", out_dir, problems)

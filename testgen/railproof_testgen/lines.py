@@ -157,7 +157,7 @@ class _CrossingLimits:
 
 
 def crossing_extent(at_mm, width_mm):
-    """[near, far) of a crossing in mm, rounded outwards (spec/design/level-crossing.md §1):
+    """[near, far) of a crossing in mm, rounded outwards (spec/design/lc.md §1):
     at - ceil(width/2), at + ceil(width/2); symmetric, so mirroring keeps it exact."""
     half = (width_mm + 1) // 2
     return at_mm - half, at_mm + half
@@ -683,7 +683,7 @@ class _Line:
                     and warn < self.lc.min_warning_ms:
                 self.err(entry, f"design warning time {warn / 1000:g} s is below "
                                 f"min_warning_time_ms {self.lc.min_warning_ms} ms "
-                                "(spec/parameters/level_crossing.yaml)")
+                                "(spec/parameters/lc.yaml)")
                 ok = False
             if not ok:
                 continue

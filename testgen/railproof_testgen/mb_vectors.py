@@ -1,4 +1,4 @@
-"""Conformance vectors of models/moving_block.pml (spec/design/moving-block.md §6).
+"""Conformance vectors of models/mb.pml (spec/design/mb.md §6).
 
 Same technique as the telegram vectors (vectors.py): one trap property per `// @goal`
 (BFS: the shortest run reaching it, replayed), goals whose label names a boundary are the
@@ -300,7 +300,7 @@ def generate(model: Path, params_dir: Path, spec_dir: Path, workdir: Path, out_d
 
     def checked(lines, name):
         return schema_checked_jsonl(
-            Path(spec_dir) / "schemas" / "vectors_moving_block.schema.json", lines, name)
+            Path(spec_dir) / "schemas" / "vectors_mb.schema.json", lines, name)
 
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)

@@ -28,9 +28,7 @@ def generate(spec_dir: Path, out_dir: Path):
     from .validate import validate_spec; validate_spec(spec_dir)  # noqa: E702
     areas = spec_mod.load_parameters(spec_dir)
     for area, data in sorted(areas.items()):
-        name = {"TG": "telegram", "MB": "moving_block", "BR": "braking",
-                "SC": "speed_check", "RA": "readhesion",
-                "LC": "level_crossing"}.get(area, area.lower())
+        name = area.lower()
         if Path(data["file"]).stem != name:  # the build declares <file stem>_params.* as outputs
             raise spec_mod.SpecError(data["file"], "area",
                                      f"area {area} generates {name}_params.*: the file must be "

@@ -1,4 +1,4 @@
-"""Conformance vectors of models/readhesion.pml (spec/design/odometry.md §5, the re-adhesion
+"""Conformance vectors of models/ra.pml (spec/design/ra.md §5, the re-adhesion
 state machine: detection, parallel start points, re-adhesion judgement, maximum
 compensation time, margin in force, sensor failure, stop demand).
 
@@ -15,7 +15,7 @@ there adds a vector to the one-start file (coverage entry "variant_vectors").
 Units: model ticks are cycles and the model's margins are fed to the C++ as mm unchanged
 (header "units"): the machine only compares ages with t_max and takes minima and maxima of
 the limits, so the abstract values are exact. Files are checked line by line against
-spec/schemas/vectors_readhesion.schema.json before they are written.
+spec/schemas/vectors_ra.schema.json before they are written.
 A goal that the exhaustive search cannot reach must be justified in spec/justifications.
 """
 from __future__ import annotations
@@ -31,7 +31,7 @@ from .errors import PipelineError, SpecError
 from .vectors import _progress, load_justifications, search_goal, write_configuration_files, write_goals_file
 from .vectors import model_bounds as _bounds
 
-# odometry::Mode and odometry::StopReason in order, named as their ToString
+# ra::Mode and ra::StopReason in order, named as their ToString
 MODES = ["TG", "COMPENSATING", "STOPPED"]
 REASONS = ["NONE", "MAX_COMPENSATION_TIME", "IMU_FAILURE", "TG_FAILURE"]
 # the model's section kinds in order (S_LONG, S_STEEP, S_SHORT)
@@ -81,7 +81,7 @@ def section_limits(b: dict):
 
 
 def to_steps(events, b: dict):
-    """Raw cycles -> vector steps (spec/schemas/vectors_readhesion.schema.json)."""
+    """Raw cycles -> vector steps (spec/schemas/vectors_ra.schema.json)."""
     limits = section_limits(b)
     steps = []
     for i, o in events:
@@ -139,7 +139,7 @@ def header_for(model: Path, b: dict, config):
         "spin_version": spin_mod.spin_version(), "configuration": config or "default",
         "units": UNITS, "unit_scales": {"cycles_per_tick": 1, "mm_per_margin_unit": 1},
         "parameters": {
-            # odometry::MachineConfig of the replay
+            # ra::MachineConfig of the replay
             "confirm_cycles": b["confirm"], "start_points": start_points, "spacing_cycles": b["spacing"],
             # the environment of the model (documentation of the vectors' range)
             "start_age_cycles": [b["start_age"], b["start_age"] + b["search_extra"]],
@@ -168,7 +168,7 @@ def generate(model: Path, params_dir: Path, spec_dir: Path, workdir: Path, out_d
     for key in BOUNDS:
         if key not in b:
             raise SpecError(Path(params_dir) / f"{model.stem}_params.pml", f"MODEL_{key.upper()}",
-                            "model bound missing (spec/parameters/readhesion.yaml model_bounds)")
+                            "model bound missing (spec/parameters/ra.yaml model_bounds)")
     workdir = Path(workdir)
     workdir.mkdir(parents=True, exist_ok=True)
     goals_file = workdir / f"{model.stem}_goals.pml"
@@ -260,4 +260,4 @@ def generate(model: Path, params_dir: Path, spec_dir: Path, workdir: Path, out_d
     return write_configuration_files(model, model_rel, ann, coverage, per_config,
                                      {c: v[0] for c, v in CONFIGS.items()},
                                      lambda cfg: header_for(model, b, cfg),
-                                     Path(spec_dir) / "schemas" / "vectors_readhesion.schema.json", out_dir, problems)
+                                     Path(spec_dir) / "schemas" / "vectors_ra.schema.json", out_dir, problems)

@@ -6,7 +6,7 @@ Command ``trace --spec DIR --src REPO_ROOT --results RESULTS_DIR --out trace.jso
 Link sources (paths relative to REPO_ROOT unless noted):
 - ``models/**/*.pml`` annotations ``// @property <ltl> REQ-… : text``,
   ``// @goal <K> REQ-… : label`` and ``// @mutant <NAME> violates <ltl> : text``;
-- ``RESULTS_DIR/spin/*.json`` (spec/design/telegram-layer.md §8): a property verifies its
+- ``RESULTS_DIR/spin/*.json`` (spec/design/tg.md §8): a property verifies its
   requirements only with verdict ``verified``; every mutant must be ``rejected``;
 - ``RESULTS_DIR/vectors/*.jsonl`` (header line, then vectors with ``id`` and
   ``requirements``) and ``*.coverage.json`` (goal coverage; an ``unreachable`` goal needs a
@@ -453,7 +453,7 @@ class Tracer:
 
     def _check_hash(self, f, sha, model_path):
         """Results from another version of the model are stale: warn (the hash is of the
-        model source file as committed, see spec/design/telegram-layer.md §8)."""
+        model source file as committed, see spec/design/tg.md §8)."""
         if not isinstance(sha, str):
             return
         actual = hashlib.sha256((self.src / model_path).read_bytes()).hexdigest()

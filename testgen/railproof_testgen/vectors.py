@@ -1,6 +1,6 @@
 """Derive conformance vectors from a SPIN model.
 
-Three kinds of vectors (spec/design/telegram-layer.md §7, schema spec/schemas/vectors.schema.json):
+Three kinds of vectors (spec/design/tg.md §7, schema spec/schemas/vectors_tg.schema.json):
 - trap: every `// @goal K` becomes a trap property `[] !g[K]`; pan (BFS) returns the
   shortest run that reaches the goal, whose replayed @IN/@OUT lines are the vector.
   Goals whose label names a boundary, edge or wrap-around are the boundary vectors.

@@ -1,5 +1,5 @@
 """Tests of the speed-supervision decision vectors (railproof_testgen.br_vectors,
-models/braking.pml, spec/schemas/vectors_braking.schema.json). The C++ conformance runner
+models/br.pml, spec/schemas/vectors_br.schema.json). The C++ conformance runner
 (railproof_conformance_br) is the behavioural check of the vectors; these tests check that
 they are generated, schema-valid, physically consistent and cover every goal and boundary."""
 import json
@@ -15,11 +15,11 @@ from railproof_testgen.errors import PipelineError
 
 REPO = Path(__file__).resolve().parents[2]
 MODEL = REPO / "models" / "braking.pml"
-SCHEMA = REPO / "spec" / "schemas" / "vectors_braking.schema.json"
+SCHEMA = REPO / "spec" / "schemas" / "vectors_br.schema.json"
 needs_spin = pytest.mark.skipif(shutil.which("spin") is None or shutil.which("cc") is None,
                                 reason="spin and a C compiler are needed")
 
-# the seeded C++ decision faults of cpp/src/braking/supervisor.cpp, each mirrored by a mutant
+# the seeded C++ decision faults of cpp/runtime/br/src/supervisor.cpp, each mirrored by a mutant
 CPP_FAULTS = ["RESET_IGNORES_HANDLE", "RELEASE_WHILE_MOVING", "NO_RELEASE_LEAD", "EMERGENCY_LATE",
               "EMERGENCY_NOT_LATCHED"]
 
@@ -78,14 +78,14 @@ def generated(tmp_path_factory):
     tmp = tmp_path_factory.mktemp("br")
     params = tmp / "params"
     params.mkdir()
-    # the model bounds of spec/parameters/braking.yaml, as gen-params writes them
+    # the model bounds of spec/parameters/br.yaml, as gen-params writes them
     data = yaml.safe_load((REPO / "spec" / "parameters" / "braking.yaml").read_text(encoding="utf-8"))
-    (params / "braking_params.pml").write_text(
+    (params / "br_params.pml").write_text(
         "".join(f"#define {e['id'].upper()} {e['value']}\n" for e in data["model_bounds"]), encoding="utf-8")
     out = tmp / "vectors"
     cov = vectors.generate(MODEL, params, REPO / "spec", tmp / "work", out, walks=4, jobs=2)
     lines = [json.loads(ln) for ln in (out / "braking.jsonl").read_text(encoding="utf-8").splitlines()]
-    return cov, lines, out, spin.read_bounds(params / "braking_params.pml")
+    return cov, lines, out, spin.read_bounds(params / "br_params.pml")
 
 
 @needs_spin
@@ -95,7 +95,7 @@ def test_vectors_are_schema_valid_and_cover_every_goal(generated):
     for n, obj in enumerate(lines, 1):
         assert not list(validator.iter_errors(obj)), f"line {n}"
     header, vecs = lines[0], lines[1:]
-    assert header["kind"] == "header" and header["model"] == "models/braking.pml"
+    assert header["kind"] == "header" and header["model"] == "models/br.pml"
     assert header["units"] == "abstract speed units = mm/s"
     assert header["model_sha256"] == spin.sha256_file(MODEL)
     ann = spin.parse_annotations(MODEL)

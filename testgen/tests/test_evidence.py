@@ -444,7 +444,7 @@ def test_failures_are_shown_and_fail_the_verdict(tmp_path):
     _write_json(results / "analysis" / "residual_error.json", res)
     unit = results / "tests" / "unit" / "radio_unit.xml"
     unit.write_text(unit.read_text().replace(
-        'name="RejectsRepetition" file="cpp/tests/unit/radio/receiver_test.cpp" line="20" '
+        'name="RejectsRepetition" file="cpp/runtime/tg/tests/receiver_test.cpp" line="20" '
         'status="run" result="completed" time="0.001" timestamp="2025-06-11T09:00:00.002" '
         'classname="Receiver" />',
         'name="RejectsRepetition" classname="Receiver" time="0.001">'
@@ -631,7 +631,7 @@ def test_pipeline_package_passes_without_warnings(pipeline_built):
     assert (c["vectors"], c["vectors_replayed_passed"], c["vectors_not_replayed"]) == (42, 42, 0)
     assert (c["assertions"], c["assertions_verified"]) == (2, 2)
     assert c["test_cases"] == c["tests_passed"] == 253
-    assert "inputs/source/models/telegram.pml" in {a["path"] for a in _read_json(
+    assert "inputs/source/models/tg.pml" in {a["path"] for a in _read_json(
         out1 / "manifest.json")["artifacts"]}
 
 

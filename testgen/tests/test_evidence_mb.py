@@ -32,7 +32,7 @@ def _inputs(tmp: Path):
     trace = json.loads((results / "trace.json").read_text(encoding="utf-8"))
     for rid in MB_REQS:
         trace["requirements"].append({"id": rid, "area": "MB", "status": "ok", "links": {
-            "model": [{"model": "models/moving_block.pml",
+            "model": [{"model": "models/mb.pml",
                        "property": f"REQ_MB_{rid[-3:]}_x", "verdict": "verified"}]}})
     (results / "trace.json").write_text(json.dumps(trace, indent=2) + "\n", encoding="utf-8")
     repo = tmp / "repo"

@@ -1,5 +1,5 @@
-"""Tests of the level-crossing vectors (railproof_testgen.lc_vectors, models/level_crossing.pml,
-spec/schemas/vectors_level_crossing.schema.json). The C++ conformance runner
+"""Tests of the level-crossing vectors (railproof_testgen.lc_vectors, models/lc.pml,
+spec/schemas/vectors_lc.schema.json). The C++ conformance runner
 (railproof_conformance_lc) is the behavioural check of the vectors; these tests check that they
 are parsed, converted to absolute times and C++ units, schema-checked, generated for every
 configuration, consistent with design note §3-§5 and cover every goal (or justify it)."""
@@ -18,12 +18,12 @@ from railproof_testgen.errors import PipelineError
 
 REPO = Path(__file__).resolve().parents[2]
 MODEL = REPO / "models" / "level_crossing.pml"
-SCHEMA = REPO / "spec" / "schemas" / "vectors_level_crossing.schema.json"
+SCHEMA = REPO / "spec" / "schemas" / "vectors_lc.schema.json"
 needs_spin = pytest.mark.skipif(shutil.which("spin") is None or shutil.which("cc") is None,
                                 reason="spin and a C compiler are needed")
 
-# the seeded C++ faults of cpp/src/onboard/crossing.cpp, cpp/src/wayside/crossing_controller.cpp
-# and cpp/src/wayside/centre_scheduler.cpp, each mirrored by a mutant of the same name
+# the seeded C++ faults of cpp/runtime/lc/src/onboard/crossing_protection.cpp, cpp/runtime/lc/src/wayside/crossing_controller.cpp
+# and cpp/runtime/lc/src/wayside/centre_scheduler.cpp, each mirrored by a mutant of the same name
 CPP_FAULTS = ["CLEAR_WITHOUT_WARNING_TIME", "WITHDRAW_AT_FRONT", "STALE_CONFIRMATION", "END_WITH_REQUESTER",
               "DEPART_WITHOUT_ALL_ACKS", "LATER_UPDATE_WHILE_WARNING"]
 CONFIG_NAMES = {"ONBOARD", "LONG_WARNING", "TWO_TRAINS", "FAIR", "HEALTHY", "GNSS", "GNSS_CLOCK", "GNSS_FAIR"}
@@ -286,16 +286,16 @@ def generated(tmp_path_factory):
     tmp = tmp_path_factory.mktemp("lc")
     params = tmp / "params"
     params.mkdir()
-    # the model bounds of spec/parameters/level_crossing.yaml, as gen-params writes them
+    # the model bounds of spec/parameters/lc.yaml, as gen-params writes them
     data = yaml.safe_load((REPO / "spec" / "parameters" / "level_crossing.yaml").read_text(encoding="utf-8"))
-    (params / "level_crossing_params.pml").write_text(
+    (params / "lc_params.pml").write_text(
         "".join(f"#define {e['id'].upper()} {e['value']}\n" for e in data["model_bounds"]), encoding="utf-8")
     out = tmp / "vectors"
     out.mkdir()
     (out / "level_crossing.stale.jsonl").write_text("{}\n", encoding="utf-8")  # an earlier run's file
     cov = vectors.generate(MODEL, params, REPO / "spec", tmp / "work", out, walks=5, jobs=2)
     files = {name: [json.loads(ln) for ln in (out / name).read_text(encoding="utf-8").splitlines()] for name in FILES}
-    b = lc_vectors.all_bounds(MODEL, params / "level_crossing_params.pml")
+    b = lc_vectors.all_bounds(MODEL, params / "lc_params.pml")
     return cov, files, out, b
 
 
@@ -309,7 +309,7 @@ def test_vectors_are_schema_valid_and_cover_every_goal(generated):
         for n, obj in enumerate(lines, 1):
             assert not list(validator.iter_errors(obj)), f"{name} line {n}"
         header = lines[0]
-        assert header["model"] == "models/level_crossing.pml" and header["model_sha256"] == spin.sha256_file(MODEL)
+        assert header["model"] == "models/lc.pml" and header["model_sha256"] == spin.sha256_file(MODEL)
         cfg = next(c for c, v in lc_vectors.CONFIGS.items() if f"level_crossing{v[0]}.jsonl" == name)
         assert header["configuration"] == (cfg or "default")
         assert len(lines) > 1

@@ -46,7 +46,7 @@ def line_spec(tmp_path):
 
 
 def contract_problems(obj):
-    """The rules the C++ loader (cpp/src/sim/line.cpp) applies to the line JSON."""
+    """The rules the C++ loader (cpp/offline/common/src/line.cpp) applies to the line JSON."""
     bad = []
     assert obj["schema"] == "railproof/line-json/1"
     for key in ("name", "title", "assumption"):

@@ -90,8 +90,8 @@ def test_generation_is_deterministic_and_covers_every_train(tmp_path):
         text = (tmp_path / "a" / "braking" / f"BR_a_stop.{t}.smt2").read_text()
         assert f"(define-fun TF_MAX () Real (/ {tf}.0 1000.0))" in text
         assert "{{" not in text and "@obligation" not in text
-    assert "spec/parameters/moving_block.yaml" in inputs1
-    assert "proofs/braking/lemmas.smt2.in" in inputs1
+    assert "spec/parameters/mb.yaml" in inputs1
+    assert "proofs/br/lemmas.smt2.in" in inputs1
 
 
 def test_lemma_uses_are_linked_to_their_proofs(tmp_path):
@@ -305,7 +305,7 @@ def test_template_errors_name_file_and_reason(cli, tmp_path, file, old, new, fra
     _edit(pr / "braking" / file, old, new)
     res = cli("proofs", "--spec", SPEC, "--proofs", pr, "--out", tmp_path / "out")
     assert res.rc == 1
-    assert "proofs/braking/" in res.err and fragment in res.err, res.err
+    assert "proofs/br/" in res.err and fragment in res.err, res.err
 
 
 def test_a_lemma_changed_in_one_place_is_unproved(cli, tmp_path):
@@ -337,20 +337,20 @@ def test_trace_reads_obligation_tags_and_expected_verdicts(tmp_path):
     t, errors = _trace(tmp_path, None)
     assert errors == []
     links = {r["id"]: r["links"]["proof"] for r in t["requirements"]}
-    assert {"file": "proofs/braking/br_b_moving_block.smt2.in",
+    assert {"file": "proofs/br/br_b_moving_block.smt2.in",
             "obligation": "BR_b_moving_block"} in links["REQ-BR-015"]
-    assert {"file": "proofs/braking/br_c_d2_buffer.smt2.in",
+    assert {"file": "proofs/br/br_c_d2_buffer.smt2.in",
             "obligation": "BR_c_d2_buffer"} in links["REQ-BR-016"]
-    assert {"file": "proofs/braking/br_a_stop.smt2.in",
+    assert {"file": "proofs/br/br_a_stop.smt2.in",
             "obligation": "BR_a_stop"} in links["REQ-BR-014"]
-    assert {"file": "proofs/braking/br_a2_rounding.smt2.in",
+    assert {"file": "proofs/br/br_a2_rounding.smt2.in",
             "obligation": "BR_a2_rounding"} in links["REQ-BR-008"]
     from railproof_testgen.trace import Tracer
     tr = Tracer(SPEC, REPO, tmp_path / "none", True)
     tr.run()
     assert tr.proof_obligations["BR_a_wrong_noerror"]["expect"] == "sat"
     assert tr.proof_obligations["BR_a_stop"]["expect"] == "unsat"
-    assert tr.proof_obligations["BR_a_stop"]["file"] == "proofs/braking/br_a_stop.smt2.in"
+    assert tr.proof_obligations["BR_a_stop"]["file"] == "proofs/br/br_a_stop.smt2.in"
 
 
 def test_trace_accepts_the_replay_and_rejects_tampered_results(tmp_path, replay):

@@ -1,5 +1,5 @@
 """Tests of the re-adhesion state machine vectors (railproof_testgen.ra_vectors,
-models/readhesion.pml, spec/schemas/vectors_readhesion.schema.json). The C++ conformance
+models/ra.pml, spec/schemas/vectors_ra.schema.json). The C++ conformance
 runner (railproof_conformance_ra) is the behavioural check of the vectors; these tests check
 that they are parsed, converted, schema-checked, generated for both machine configurations,
 consistent with design note §5 and cover every goal (or justify it)."""
@@ -17,11 +17,11 @@ from railproof_testgen.errors import PipelineError
 
 REPO = Path(__file__).resolve().parents[2]
 MODEL = REPO / "models" / "readhesion.pml"
-SCHEMA = REPO / "spec" / "schemas" / "vectors_readhesion.schema.json"
+SCHEMA = REPO / "spec" / "schemas" / "vectors_ra.schema.json"
 needs_spin = pytest.mark.skipif(shutil.which("spin") is None or shutil.which("cc") is None,
                                 reason="spin and a C compiler are needed")
 
-# the seeded C++ faults of cpp/src/odometry/readhesion_machine.cpp, each mirrored by a mutant
+# the seeded C++ faults of cpp/runtime/ra/src/readhesion_machine.cpp, each mirrored by a mutant
 CPP_FAULTS = ["TIMEOUT_OFF_BY_ONE", "CONFIRM_TWO", "SPEED_IGNORED", "EPISODE_RELAXES", "LAST_CANDIDATE_WINS",
               "TG_FAILURE_IGNORED"]
 BOUNDS = {"confirm": 3, "start_age": 2, "search_extra": 1, "spacing": 2, "tmax_long": 9, "tmax_short": 6,
@@ -169,9 +169,9 @@ def generated(tmp_path_factory):
     tmp = tmp_path_factory.mktemp("ra")
     params = tmp / "params"
     params.mkdir()
-    # the model bounds of spec/parameters/readhesion.yaml, as gen-params writes them
+    # the model bounds of spec/parameters/ra.yaml, as gen-params writes them
     data = yaml.safe_load((REPO / "spec" / "parameters" / "readhesion.yaml").read_text(encoding="utf-8"))
-    (params / "readhesion_params.pml").write_text(
+    (params / "ra_params.pml").write_text(
         "".join(f"#define {e['id'].upper()} {e['value']}\n" for e in data["model_bounds"]), encoding="utf-8")
     out = tmp / "vectors"
     out.mkdir()
@@ -180,7 +180,7 @@ def generated(tmp_path_factory):
     files = {}
     for name in ("readhesion.jsonl", "readhesion.one_start.jsonl"):
         files[name] = [json.loads(ln) for ln in (out / name).read_text(encoding="utf-8").splitlines()]
-    return cov, files, out, spin.read_bounds(params / "readhesion_params.pml")
+    return cov, files, out, spin.read_bounds(params / "ra_params.pml")
 
 
 @needs_spin
@@ -193,7 +193,7 @@ def test_vectors_are_schema_valid_and_cover_every_goal(generated):
         for n, obj in enumerate(lines, 1):
             assert not list(validator.iter_errors(obj)), f"{name} line {n}"
         header = lines[0]
-        assert header["model"] == "models/readhesion.pml" and header["model_sha256"] == spin.sha256_file(MODEL)
+        assert header["model"] == "models/ra.pml" and header["model_sha256"] == spin.sha256_file(MODEL)
         one = name == "readhesion.one_start.jsonl"
         assert header["configuration"] == ("ONE_START" if one else "default")
         assert header["parameters"]["start_points"] == (1 if one else 2)

@@ -93,9 +93,9 @@ def test_output_is_deterministic_and_location_independent(tree, trace, tmp_path)
 @pytest.mark.parametrize("case, file, entry, fragment, rid", [
     ("dangling_verifies", "cpp/tests/unit/demo/extra_test.cpp", "@verifies (line 3)",
      "dangling reference: unknown requirement REQ-TG-099", None),
-    ("sil4_no_code", "spec/requirements/telegram.yaml", "REQ-TG-001",
+    ("sil4_no_code", "spec/requirements/tg.yaml", "REQ-TG-001",
      "SIL-4 requirement has no @implements code unit", "REQ-TG-001"),
-    ("sil4_unverified", "spec/requirements/telegram.yaml", "REQ-TG-001",
+    ("sil4_unverified", "spec/requirements/tg.yaml", "REQ-TG-001",
      "verification 'unit': no @verifies test", "REQ-TG-001"),
     ("violated_property", "spin/demo.json", "property REQ_TG_001_repetition",
      "property violated", "REQ-TG-001"),
@@ -119,7 +119,7 @@ def test_trace_error_classes(tree, trace, case, file, entry, fragment, rid):
 
 def test_violated_property_also_leaves_model_verification_unmet(tree, trace):
     r = trace(tree("violated_property"))
-    assert r.has("spec/requirements/telegram.yaml", "REQ-TG-001",
+    assert r.has("spec/requirements/tg.yaml", "REQ-TG-001",
                  "verification 'model': no property naming it is verified")
     assert r.trace["summary"]["properties"]["violated"] == 1
 
@@ -128,7 +128,7 @@ def test_empty_vectors_leave_coverage_dangling(tree, trace):
     r = trace(tree("empty_vectors"))
     assert r.has("vectors/demo.coverage.json", "goal G1",
                  "dangling reference: vector TG-TRAP-001")
-    assert r.has("spec/requirements/telegram.yaml", "REQ-TG-001",
+    assert r.has("spec/requirements/tg.yaml", "REQ-TG-001",
                  "verification 'vectors': no vector names it")
 
 
@@ -167,10 +167,10 @@ def test_empty_vectors_leave_coverage_dangling(tree, trace):
     ("results/vectors/demo.coverage.json", '"justification": "UR-TG-001"',
      '"justification": "UR-TG-009"', "vectors/demo.coverage.json", "goal G2",
      "dangling reference: justification UR-TG-009"),
-    ("spec/justifications/telegram.yaml", "goal: G2", "goal: G1",
+    ("spec/justifications/tg.yaml", "goal: G2", "goal: G1",
      "vectors/demo.coverage.json", "goal G2", "justification UR-TG-001 is for goal G1"),
-    ("spec/justifications/telegram.yaml", "model: models/demo.pml", "model: models/other.pml",
-     "spec/justifications/telegram.yaml", "UR-TG-001", "model models/other.pml not found"),
+    ("spec/justifications/tg.yaml", "model: models/demo.pml", "model: models/other.pml",
+     "spec/justifications/tg.yaml", "UR-TG-001", "model models/other.pml not found"),
     ("results/vectors/demo.coverage.json", '"reached": 1', '"reached": 2',
      "vectors/demo.coverage.json", "reached", "says 2 but 1 goals are reached"),
     # C++ and proofs
@@ -231,7 +231,7 @@ def test_requirement_without_any_vector(tree, trace):
                    encoding="utf-8")
     r = trace(root)
     assert r.rc == 1
-    assert r.has("spec/requirements/telegram.yaml", "REQ-TG-001",
+    assert r.has("spec/requirements/tg.yaml", "REQ-TG-001",
                  "verification 'vectors': no vector names it")
     # coverage and @goal annotations disagree about the goal's requirements
     assert r.has("vectors/demo.coverage.json", "goal G1", "differ from the @goal annotation")
@@ -253,7 +253,7 @@ def test_missing_results_are_warnings_with_flag(tree, trace):
     r = trace(root, "--allow-missing-results")
     assert r.rc == 0, r.err
     assert r.warned("results/spin", "-", "allowed by --allow-missing-results")
-    assert r.warned("spec/requirements/telegram.yaml", "REQ-TG-001",
+    assert r.warned("spec/requirements/tg.yaml", "REQ-TG-001",
                     "not yet verified (model-checking results missing)")
     tg1 = _req(r, "REQ-TG-001")
     assert tg1["status"] == "ok"
@@ -265,7 +265,7 @@ def test_flag_does_not_hide_source_problems_or_bad_results(tree, trace):
     shutil.rmtree(root / "results" / "vectors")
     r = trace(root, "--allow-missing-results")
     assert r.rc == 1
-    assert r.has("spec/requirements/telegram.yaml", "REQ-TG-001", "SIL-4 requirement has no")
+    assert r.has("spec/requirements/tg.yaml", "REQ-TG-001", "SIL-4 requirement has no")
     root = tree("violated_property")
     r = trace(root, "--allow-missing-results")
     assert r.rc == 1 and r.has("spin/demo.json", "property REQ_TG_001_repetition", "violated")
@@ -279,7 +279,7 @@ def test_flag_still_requires_a_property_annotation(tree, trace):
     _edit(root / "models/demo.pml", "violates REQ_TG_001_repetition", "violates gone")
     r = trace(root, "--allow-missing-results")
     assert r.rc == 1
-    assert r.has("spec/requirements/telegram.yaml", "REQ-TG-001",
+    assert r.has("spec/requirements/tg.yaml", "REQ-TG-001",
                  "verification 'model': no @property in models/ names this requirement")
 
 
@@ -305,7 +305,7 @@ def test_disabled_test_does_not_count(tree, trace):
     r = trace(root)
     assert r.rc == 1
     assert r.warned("demo_test.cpp", "@verifies (line 4)", "is disabled")
-    assert r.has("spec/requirements/telegram.yaml", "REQ-TG-001", "verification 'unit'")
+    assert r.has("spec/requirements/tg.yaml", "REQ-TG-001", "verification 'unit'")
 
 
 def test_all_trace_errors_are_collected(tree, trace):
@@ -317,7 +317,7 @@ def test_all_trace_errors_are_collected(tree, trace):
             ("extra_test.cpp", "@verifies", "REQ-TG-099"),
             ("spin/demo.json", "mutant MUTANT_NO_REPEAT_CHECK", "survived"),
             ("vectors/demo.coverage.json", "goal G2", "without a justification"),
-            ("spec/requirements/telegram.yaml", "REQ-TG-001", "SIL-4")]:
+            ("spec/requirements/tg.yaml", "REQ-TG-001", "SIL-4")]:
         assert r.has(file, entry, fragment), (file, r.err)
     assert r.trace["summary"]["errors"] == len(r.trace["errors"]) >= 4
 

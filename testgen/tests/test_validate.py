@@ -127,7 +127,7 @@ def test_requirement_rules(tree, cli, old, new, file, entry, fragment):
 
 def test_unaddressed_hazard_is_an_error(tree, cli):
     root = tree()
-    _edit(root / "spec/requirements/moving_block.yaml", "hazards: [HAZ-003]",
+    _edit(root / "spec/requirements/mb.yaml", "hazards: [HAZ-003]",
           "hazards: [HAZ-001]")
     r = cli("validate", "--spec", root / "spec")
     assert r.rc == 1
@@ -150,7 +150,7 @@ def test_unaddressed_hazard_is_an_error(tree, cli):
 ])
 def test_parameter_rules(tree, cli, old, new, entry, fragment):
     root = tree()
-    _edit(root / "spec/parameters/telegram.yaml", old, new)
+    _edit(root / "spec/parameters/tg.yaml", old, new)
     r = cli("validate", "--spec", root / "spec")
     assert r.rc == 1
     assert r.has("parameters/telegram.yaml", entry, fragment), r.err
@@ -158,7 +158,7 @@ def test_parameter_rules(tree, cli, old, new, entry, fragment):
 
 def test_two_parameter_files_for_one_area(tree, cli):
     root = tree()
-    src = root / "spec/parameters/telegram.yaml"
+    src = root / "spec/parameters/tg.yaml"
     (root / "spec/parameters/telegram2.yaml").write_text(src.read_text(encoding="utf-8"),
                                                          encoding="utf-8")
     r = cli("validate", "--spec", root / "spec")
@@ -168,7 +168,7 @@ def test_two_parameter_files_for_one_area(tree, cli):
 
 def test_justification_rules(tree, cli):
     root = tree()
-    _edit(root / "spec/justifications/telegram.yaml", "id: UR-TG-001", "id: UR-XX-001")
+    _edit(root / "spec/justifications/tg.yaml", "id: UR-TG-001", "id: UR-XX-001")
     r = cli("validate", "--spec", root / "spec")
     assert r.rc == 1
     assert r.has("justifications/telegram.yaml", "UR-XX-001", "does not match")
@@ -185,8 +185,8 @@ def test_yml_extension_is_not_silently_ignored(tree, cli):
 
 def test_unreferenced_assumption_is_a_warning(tree, cli):
     root = tree()
-    _edit(root / "spec/parameters/telegram.yaml", "source: ASM-001", "source: D5 §6.3")
-    _edit(root / "spec/requirements/telegram.yaml", "[EN 50159 §7.3, ASM-001]",
+    _edit(root / "spec/parameters/tg.yaml", "source: ASM-001", "source: D5 §6.3")
+    _edit(root / "spec/requirements/tg.yaml", "[EN 50159 §7.3, ASM-001]",
           "[EN 50159 §7.3]")
     r = cli("validate", "--spec", root / "spec")
     assert r.rc == 0, r.err
@@ -233,7 +233,7 @@ def test_gen_params_on_valid_spec(tree, tmp_path, cli):
     root = tree()
     r = cli("gen-params", "--spec", root / "spec", "--out", tmp_path / "gen")
     assert r.rc == 0, r.err
-    hdr = (tmp_path / "gen/include/railproof/generated/telegram_params.hpp").read_text()
+    hdr = (tmp_path / "gen/include/railproof/generated/tg_params.hpp").read_text()
     assert "inline constexpr auto crc16_poly = std::int64_t{4129};" in hdr
 
 

@@ -1,0 +1,290 @@
+# One registration call per C++ module, tool and test set (cpp/**/CMakeLists.txt). Every
+# target states what it links; the kind of each target (runtime, offline, test) and its
+# links are recorded and written to build/gen/targets.json at the end of the configure step,
+# where `railproof_testgen layout` checks the module boundaries (a runtime target whose link
+# closure reaches an offline target, train-side code linking ground-side code, ...).
+#
+#   railproof_runtime_module(<name> SOURCES ... [LINKS <module names or imported targets>]
+#                            [CAPABILITY <cap>] [SIDE common|onboard|wayside])
+#       STATIC library railproof_<name> with include/ PUBLIC; runtime rules (-fno-exceptions,
+#       -fno-rtti, warnings as errors). With RAILPROOF_FAULT_BUILDS and a capability whose
+#       registry entry has seeded faults, also railproof_<name>_faults: the same sources
+#       compiled once with RAILPROOF_SEEDED_FAULTS (mutant schemata: every fault of the module
+#       in one test-only variant, selected at run time, spec/design/seeded-faults.md).
+#   railproof_offline_module(<name> SOURCES ... [LINKS ...])     STATIC library railproof_<name>
+#   railproof_tool(<name> SOURCES ... [LINKS ...])               offline executable <name>
+#   railproof_test_set(<name> SOURCES ... [LINKS ...] [RUNTIME] [LABELS ...])
+#       GoogleTest executable railproof_<name>_tests, every test case a ctest entry; the test
+#       sources are compiled once (OBJECT library). RUNTIME: links runtime modules only, and
+#       with faults also railproof_<name>_tests_faults (the same objects against the
+#       *_faults variants) for the unit_fault_<F> entries.
+#   railproof_conformance(<cap> SOURCES ... [LINKS ...])
+#       railproof_conformance_<cap> replaying the pipeline's vectors, its negative tests, and
+#       the conformance_fault_<F> entries of the faults the registry says the vectors kill.
+#   railproof_bench(SOURCES ... [LINKS ...])                      sources of railproof_bench
+
+set_property(GLOBAL PROPERTY RAILPROOF_TARGET_KINDS "")
+
+function(_railproof_record target kind)
+  set_property(GLOBAL APPEND PROPERTY RAILPROOF_TARGET_KINDS "${target}=${kind}")
+endfunction()
+
+# module names (tg, lc_onboard, offline, ...) become railproof_<name> when that target exists
+# (modules are registered before their users); anything else (imported targets, library
+# paths and names) stays as it is.
+function(_railproof_resolve out)
+  set(res)
+  foreach(l ${ARGN})
+    if(TARGET railproof_${l})
+      list(APPEND res railproof_${l})
+    else()
+      list(APPEND res ${l})
+    endif()
+  endforeach()
+  set(${out} ${res} PARENT_SCOPE)
+endfunction()
+
+# the faulty variant of a runtime module if it has one, else the module itself
+function(_railproof_faulty out)
+  set(res)
+  foreach(l ${ARGN})
+    if(TARGET ${l}_faults)
+      list(APPEND res ${l}_faults)
+    else()
+      list(APPEND res ${l})
+    endif()
+  endforeach()
+  set(${out} ${res} PARENT_SCOPE)
+endfunction()
+
+function(_railproof_has_faults cap out)
+  set(${out} OFF PARENT_SCOPE)
+  if(RAILPROOF_FAULT_BUILDS AND cap AND RAILPROOF_CAP_${cap}_FAULTS)
+    set(${out} ON PARENT_SCOPE)
+  endif()
+endfunction()
+
+function(railproof_runtime_module name)
+  cmake_parse_arguments(A "" "CAPABILITY;SIDE" "SOURCES;LINKS" ${ARGN})
+  _railproof_resolve(links ${A_LINKS})
+  set(t railproof_${name})
+  if(A_SOURCES)
+    add_library(${t} STATIC ${A_SOURCES})
+    target_include_directories(${t} PUBLIC ${CMAKE_CURRENT_SOURCE_DIR}/include ${RAILPROOF_GEN_INCLUDE})
+    target_link_libraries(${t} PUBLIC ${links} PRIVATE railproof_runtime_options)
+  else()
+    add_library(${t} INTERFACE)
+    target_include_directories(${t} INTERFACE ${CMAKE_CURRENT_SOURCE_DIR}/include ${RAILPROOF_GEN_INCLUDE})
+    target_link_libraries(${t} INTERFACE ${links})
+  endif()
+  add_dependencies(${t} railproof_gen_params)
+  set(side ${A_SIDE})
+  if(NOT side)
+    set(side common)
+  endif()
+  _railproof_record(${t} "runtime:${side}:${A_CAPABILITY}")
+  set_property(GLOBAL PROPERTY RAILPROOF_LINKS_${t} ${links})
+  # the schemata variant exists only for modules that hold fault sites; the others are linked
+  # as they are
+  _railproof_has_faults("${A_CAPABILITY}" faults)
+  set(sites OFF)
+  foreach(src ${A_SOURCES})
+    file(STRINGS ${CMAKE_CURRENT_SOURCE_DIR}/${src} hit REGEX "RAILPROOF_FAULT\\(")
+    if(hit)
+      set(sites ON)
+    endif()
+  endforeach()
+  if(A_SOURCES)
+    # the production build holds no seeded fault: no selector is linked into it
+    add_test(NAME no_seeded_fault_in_${t} COMMAND ${CMAKE_NM} -C $<TARGET_FILE:${t}>)
+    set_tests_properties(no_seeded_fault_in_${t} PROPERTIES LABELS "seeded_fault;layout"
+      FAIL_REGULAR_EXPRESSION "SeededFault")
+  endif()
+  if(faults AND sites)
+    _railproof_faulty(flinks ${links})
+    add_library(${t}_faults STATIC ${A_SOURCES})
+    target_include_directories(${t}_faults PUBLIC ${CMAKE_CURRENT_SOURCE_DIR}/include ${RAILPROOF_GEN_INCLUDE})
+    target_compile_definitions(${t}_faults PRIVATE RAILPROOF_SEEDED_FAULTS)
+    target_link_libraries(${t}_faults PUBLIC ${flinks} railproof_seeded_faults PRIVATE railproof_runtime_options)
+    add_dependencies(${t}_faults railproof_gen_params)
+    _railproof_record(${t}_faults "test:schemata:${A_CAPABILITY}")
+    # ... and the check above can see a selector: the schemata variant has one
+    add_test(NAME seeded_fault_selector_in_${t}_faults COMMAND ${CMAKE_NM} -C $<TARGET_FILE:${t}_faults>)
+    set_tests_properties(seeded_fault_selector_in_${t}_faults PROPERTIES LABELS "seeded_fault;layout"
+      PASS_REGULAR_EXPRESSION "SeededFaultActive")
+    set_property(GLOBAL PROPERTY RAILPROOF_LINKS_${t}_faults ${flinks};railproof_seeded_faults)
+  endif()
+endfunction()
+
+function(railproof_offline_module name)
+  cmake_parse_arguments(A "" "" "SOURCES;LINKS" ${ARGN})
+  _railproof_resolve(links ${A_LINKS})
+  set(t railproof_${name})
+  add_library(${t} STATIC ${A_SOURCES})
+  target_include_directories(${t} PUBLIC ${CMAKE_CURRENT_SOURCE_DIR}/include ${RAILPROOF_GEN_INCLUDE})
+  target_link_libraries(${t} PUBLIC ${links} PRIVATE railproof_options)
+  add_dependencies(${t} railproof_gen_params)
+  _railproof_record(${t} "offline")
+  set_property(GLOBAL PROPERTY RAILPROOF_LINKS_${t} ${links})
+endfunction()
+
+function(railproof_tool name)
+  cmake_parse_arguments(A "" "" "SOURCES;LINKS" ${ARGN})
+  _railproof_resolve(links ${A_LINKS})
+  add_executable(${name} ${A_SOURCES})
+  target_link_libraries(${name} PRIVATE ${links} railproof_options)
+  _railproof_record(${name} "offline")
+  set_property(GLOBAL PROPERTY RAILPROOF_LINKS_${name} ${links})
+endfunction()
+
+function(railproof_test_set name)
+  cmake_parse_arguments(A "RUNTIME" "CAPABILITY" "SOURCES;LINKS;LABELS" ${ARGN})
+  _railproof_resolve(links ${A_LINKS})
+  set(objs railproof_${name}_test_objects)
+  add_library(${objs} OBJECT ${A_SOURCES})
+  # the test objects see the headers of what they test (and GoogleTest); they are compiled once
+  target_link_libraries(${objs} PRIVATE ${links} railproof_testing GTest::gtest railproof_options)
+  add_dependencies(${objs} railproof_gen_lines railproof_gen_trains)
+  set(exe railproof_${name}_tests)
+  add_executable(${exe} $<TARGET_OBJECTS:${objs}>)
+  target_link_libraries(${exe} PRIVATE ${links} railproof_testing GTest::gtest_main railproof_options)
+  if(A_RUNTIME)
+    set(kind "test:runtime:${A_CAPABILITY}")
+  else()
+    set(kind "test:offline:${A_CAPABILITY}")
+  endif()
+  _railproof_record(${exe} "${kind}")
+  set_property(GLOBAL PROPERTY RAILPROOF_LINKS_${exe} ${links})
+  set(labels unit ${A_LABELS})
+  if(A_CAPABILITY)
+    list(APPEND labels ${A_CAPABILITY})
+  endif()
+  gtest_discover_tests(${exe}
+    TEST_PREFIX "${name}."
+    XML_OUTPUT_DIR ${RAILPROOF_RESULTS_DIR}/tests/unit/${name}
+    PROPERTIES LABELS "${labels}"
+    DISCOVERY_TIMEOUT 60)
+  _railproof_has_faults("${A_CAPABILITY}" faults)
+  if(A_RUNTIME AND faults)
+    _railproof_faulty(flinks ${links})
+    set(fexe ${exe}_faults)
+    add_executable(${fexe} $<TARGET_OBJECTS:${objs}>)
+    target_link_libraries(${fexe} PRIVATE ${flinks} railproof_testing GTest::gtest_main railproof_options)
+    _railproof_record(${fexe} "test:schemata:${A_CAPABILITY}")
+    set_property(GLOBAL PROPERTY RAILPROOF_LINKS_${fexe} ${flinks})
+    foreach(fault ${RAILPROOF_CAP_${A_CAPABILITY}_FAULTS_UNIT})
+      add_test(NAME unit_fault_${fault} COMMAND ${fexe}
+               --gtest_output=xml:${RAILPROOF_RESULTS_DIR}/tests/faults/unit_${fault}.xml)
+      set_tests_properties(unit_fault_${fault} PROPERTIES
+        LABELS "seeded_fault;${A_CAPABILITY}" ENVIRONMENT "RAILPROOF_SEEDED_FAULT=${fault}"
+        PASS_REGULAR_EXPRESSION "\\[  FAILED  \\] [1-9][0-9]* tests?, listed below")
+    endforeach()
+    # the schemata build with no fault selected behaves as the production build
+    add_test(NAME unit_faults_none_selected_${A_CAPABILITY} COMMAND ${fexe})
+    set_tests_properties(unit_faults_none_selected_${A_CAPABILITY} PROPERTIES LABELS "seeded_fault;${A_CAPABILITY}")
+  endif()
+endfunction()
+
+function(railproof_conformance cap)
+  cmake_parse_arguments(A "" "" "SOURCES;LINKS" ${ARGN})
+  _railproof_resolve(links ${A_LINKS})
+  set(objs railproof_conformance_${cap}_objects)
+  add_library(${objs} OBJECT ${A_SOURCES})
+  target_link_libraries(${objs} PRIVATE ${links} railproof_testing GTest::gtest nlohmann_json::nlohmann_json
+                        railproof_options)
+  set(exe railproof_conformance_${cap})
+  add_executable(${exe} $<TARGET_OBJECTS:${objs}>)
+  target_link_libraries(${exe} PRIVATE ${links} railproof_testing GTest::gtest nlohmann_json::nlohmann_json
+                        railproof_options)
+  _railproof_record(${exe} "test:runtime:${cap}")
+  set_property(GLOBAL PROPERTY RAILPROOF_LINKS_${exe} ${links})
+  set(prog "railproof-conformance-${cap}")
+  add_test(NAME conformance_${cap}
+           COMMAND ${exe} --vectors ${RAILPROOF_CONFORMANCE_VECTORS}
+                   --gtest_output=xml:${RAILPROOF_RESULTS_DIR}/tests/conformance/${cap}.xml)
+  set_tests_properties(conformance_${cap} PROPERTIES LABELS "conformance;${cap}")
+  add_test(NAME conformance_${cap}_rejects_missing_dir
+           COMMAND ${exe} --vectors ${CMAKE_CURRENT_BINARY_DIR}/no_such_dir)
+  add_test(NAME conformance_${cap}_rejects_empty_dir
+           COMMAND ${exe} --vectors ${RAILPROOF_EMPTY_VECTOR_DIR})
+  set_tests_properties(conformance_${cap}_rejects_missing_dir PROPERTIES LABELS "conformance;${cap}"
+    PASS_REGULAR_EXPRESSION "${prog}: error: vector directory .* does not exist")
+  set_tests_properties(conformance_${cap}_rejects_empty_dir PROPERTIES LABELS "conformance;${cap}"
+    PASS_REGULAR_EXPRESSION "${prog}: error: no \\*\\.jsonl vector file")
+  _railproof_has_faults("${cap}" faults)
+  if(faults)
+    _railproof_faulty(flinks ${links})
+    set(fexe ${exe}_faults)
+    add_executable(${fexe} $<TARGET_OBJECTS:${objs}>)
+    target_link_libraries(${fexe} PRIVATE ${flinks} railproof_testing GTest::gtest nlohmann_json::nlohmann_json
+                          railproof_options)
+    _railproof_record(${fexe} "test:schemata:${cap}")
+    set_property(GLOBAL PROPERTY RAILPROOF_LINKS_${fexe} ${flinks})
+    foreach(fault ${RAILPROOF_CAP_${cap}_FAULTS_VECTORS})
+      add_test(NAME conformance_fault_${fault}
+               COMMAND ${fexe} --vectors ${RAILPROOF_CONFORMANCE_VECTORS}
+                       --gtest_output=xml:${RAILPROOF_RESULTS_DIR}/tests/faults/conformance_${fault}.xml)
+      set_tests_properties(conformance_fault_${fault} PROPERTIES
+        LABELS "conformance;seeded_fault;${cap}" ENVIRONMENT "RAILPROOF_SEEDED_FAULT=${fault}"
+        PASS_REGULAR_EXPRESSION "${prog}: vectors mismatched: [1-9][0-9]* of")
+    endforeach()
+    add_test(NAME conformance_faults_none_selected_${cap}
+             COMMAND ${fexe} --vectors ${RAILPROOF_CONFORMANCE_VECTORS})
+    set_tests_properties(conformance_faults_none_selected_${cap} PROPERTIES
+      LABELS "conformance;seeded_fault;${cap}" PASS_REGULAR_EXPRESSION "${prog}: all [0-9]+ vectors passed")
+  endif()
+endfunction()
+
+function(railproof_bench)
+  cmake_parse_arguments(A "" "" "SOURCES;LINKS" ${ARGN})
+  if(NOT RAILPROOF_BENCH)
+    return()
+  endif()
+  _railproof_resolve(links ${A_LINKS})
+  set_property(GLOBAL APPEND PROPERTY RAILPROOF_BENCH_SOURCES ${A_SOURCES})
+  set_property(GLOBAL APPEND PROPERTY RAILPROOF_BENCH_LINKS ${links})
+endfunction()
+
+# build/gen/targets.json: every registered target with its kind and direct links.
+function(railproof_write_targets file)
+  get_property(kinds GLOBAL PROPERTY RAILPROOF_TARGET_KINDS)
+  set(json "{\n  \"schema\": \"railproof/targets/1\",\n  \"targets\": {")
+  set(sep "")
+  foreach(entry ${kinds})
+    string(REPLACE "=" ";" kv "${entry}")
+    list(GET kv 0 t)
+    list(GET kv 1 kind)
+    get_property(deps GLOBAL PROPERTY RAILPROOF_LINKS_${t})
+    string(REPLACE ";" "\", \"" deps_json "${deps}")
+    if(deps_json)
+      set(deps_json "\"${deps_json}\"")
+    endif()
+    string(APPEND json "${sep}\n    \"${t}\": {\"kind\": \"${kind}\", \"links\": [${deps_json}]}")
+    set(sep ",")
+  endforeach()
+  string(APPEND json "\n  }\n}\n")
+  file(WRITE ${file}.tmp "${json}")
+  file(COPY_FILE ${file}.tmp ${file} ONLY_IF_DIFFERENT)
+  file(REMOVE ${file}.tmp)
+endfunction()
+
+# railproof_study(<name> OUTPUTS <first is the result JSON> ... COMMAND ... DEPENDS ... [COMMENT ...])
+#   A pipeline step of the capability's offline analyses (only with RAILPROOF_PIPELINE): its
+#   result feeds the trace and the evidence. Runs in parallel with every other step it does
+#   not depend on.
+function(railproof_study name)
+  cmake_parse_arguments(A "" "COMMENT" "OUTPUTS;COMMAND;DEPENDS" ${ARGN})
+  if(NOT RAILPROOF_PIPELINE)
+    return()
+  endif()
+  if(NOT A_COMMENT)
+    set(A_COMMENT "study: ${name}")
+  endif()
+  add_custom_command(OUTPUT ${A_OUTPUTS}
+    COMMAND ${CMAKE_COMMAND} -E make_directory ${RAILPROOF_RESULTS_DIR}/analysis
+    COMMAND ${A_COMMAND}
+    DEPENDS ${A_DEPENDS}
+    COMMENT "${A_COMMENT}" VERBATIM)
+  list(GET A_OUTPUTS 0 result)
+  set_property(GLOBAL APPEND PROPERTY RAILPROOF_STUDY_OUTPUTS ${result})
+endfunction()

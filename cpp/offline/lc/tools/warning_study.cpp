@@ -1,0 +1,210 @@
+// warning_study: warning times of the level crossings of a line under a timetable for fixed
+// treadles, on-board requests (without / with dwell awareness) and GNSS-time pre-arming
+// (REQ-LC-017; spec/design/lc.md, spec/timetables/README.md).
+//
+// Exit status: 0 pass; 1 a warning of an on-board or GNSS-time method shorter than the
+// design warning time, or a train braked by a crossing's protection pattern (contract
+// method; each named on stderr); 2 bad input or error.
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <exception>
+#include <filesystem>
+#include <map>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "railproof/offline/train_type.hpp"
+#include "railproof/lc/analysis/warning_study.hpp"
+#include "railproof/offline/line.hpp"
+#include "railproof/offline/output_file.hpp"
+
+namespace {
+
+namespace an = railproof::lc::analysis;
+using railproof::offline::InputError;
+
+void PrintHelp() {
+  std::printf(
+      "usage: warning_study --line FILE.json --timetable FILE.yaml --trains-dir DIR --json OUT.json\n"
+      "                     [--svg-dir DIR] [--lead-sweep S,S,...] [--quiet] [--help]\n"
+      "\n"
+      "Warning-time study of level crossings (REQ-LC-017, also REQ-LC-002/005/008/015). Every\n"
+      "service of the timetable is simulated on the line (kinematic model, seeded driver\n"
+      "variation); for every crossing it passes, the warning time (arrival at the near edge\n"
+      "minus warning start) is computed for fixed treadles, the on-board request (runtime\n"
+      "lc::onboard::CrossingProtection: without and with dwell awareness, and dwell-aware from the\n"
+      "approach on) and GNSS-time pre-arming; trains the protection pattern would brake are\n"
+      "counted (runtime braking patterns and supervision).\n"
+      "\n"
+      "  --line FILE        generated line JSON (build/gen/lines/<line>.json)\n"
+      "  --timetable FILE   timetable (spec/timetables/<line>.yaml, schema railproof/timetable/1)\n"
+      "  --trains-dir DIR   generated train JSON (build/gen/trains)\n"
+      "  --json OUT         result JSON (requirements, per-method statistics, requirement rows,\n"
+      "                     per-crossing rows with meets_target, every passage)\n"
+      "  --svg-dir DIR      one histogram per method: warning_time_<method>.svg\n"
+      "  --lead-sweep S,..  also run the on-board methods with these request leads (s) and\n"
+      "                     report trains braked and warning times per lead (sensitivity of\n"
+      "                     REQ-LC-015 to request_lead_ms; informational)\n"
+      "  --quiet            no progress on stderr\n"
+      "\n"
+      "Exit status: 0 pass; 1 a warning of an on-board or GNSS-time method below the design\n"
+      "warning time, or a train braked by the protection pattern (named on stderr); 2 bad input.\n");
+}
+
+[[noreturn]] void Usage(const std::string& reason) {
+  std::fprintf(stderr, "warning_study: %s (see --help)\n", reason.c_str());
+  std::exit(2);
+}
+
+struct Options {
+  std::string line, timetable, trains_dir, json, svg_dir;
+  std::vector<std::int64_t> lead_sweep_ms;
+  bool quiet = false;
+};
+
+Options ParseArgs(int argc, char** argv) {
+  Options o;
+  for (int i = 1; i < argc; ++i) {
+    const std::string_view a = argv[i];
+    auto value = [&]() -> std::string {
+      if (i + 1 >= argc) {
+        Usage(std::string(a) + " needs a value");
+      }
+      return argv[++i];
+    };
+    if (a == "--help" || a == "-h") {
+      PrintHelp();
+      std::exit(0);
+    } else if (a == "--line") {
+      o.line = value();
+    } else if (a == "--timetable") {
+      o.timetable = value();
+    } else if (a == "--trains-dir") {
+      o.trains_dir = value();
+    } else if (a == "--json") {
+      o.json = value();
+    } else if (a == "--svg-dir") {
+      o.svg_dir = value();
+    } else if (a == "--lead-sweep") {
+      const std::string v = value();
+      std::size_t pos = 0;
+      while (pos <= v.size()) {
+        const std::size_t comma = std::min(v.find(',', pos), v.size());
+        const std::string item = v.substr(pos, comma - pos);
+        char* end = nullptr;
+        const double sec = std::strtod(item.c_str(), &end);
+        if (item.empty() || end != item.c_str() + item.size() || !(sec >= 0.0 && sec <= 600.0)) {
+          Usage("--lead-sweep: not a list of seconds in [0, 600]: '" + v + "'");
+        }
+        o.lead_sweep_ms.push_back(static_cast<std::int64_t>(std::llround(sec * 1000.0)));
+        pos = comma + 1;
+      }
+    } else if (a == "--quiet") {
+      o.quiet = true;
+    } else {
+      Usage("unknown option '" + std::string(a) + "'");
+    }
+  }
+  for (const auto& [v, name] : {std::pair{o.line, "--line"}, std::pair{o.timetable, "--timetable"},
+                                std::pair{o.trains_dir, "--trains-dir"}, std::pair{o.json, "--json"}}) {
+    if (v.empty()) {
+      Usage(std::string(name) + " is required");
+    }
+  }
+  return o;
+}
+
+int Main(int argc, char** argv) {
+  const Options o = ParseArgs(argc, argv);
+  const auto t0 = std::chrono::steady_clock::now();
+  const railproof::offline::Line line = railproof::offline::LoadLine(o.line);
+  const an::Timetable tt = an::LoadTimetable(o.timetable);
+  std::map<std::string, an::TrainType> trains;
+  for (const auto& sv : tt.services) {
+    if (trains.count(sv.train) != 0U) {
+      continue;
+    }
+    const std::filesystem::path p = std::filesystem::path(o.trains_dir) / (sv.train + ".json");
+    if (!std::filesystem::exists(p)) {
+      throw InputError(tt.file + ": service " + sv.id + ": train type '" + sv.train + "' not found (" + p.string() + ")");
+    }
+    trains.emplace(sv.train, an::LoadTrainType(p));
+  }
+  an::StudyInputs in{&line, &tt, &trains};
+  const an::StudyResult r = an::RunStudy(in, [&](std::size_t done, std::size_t total) {
+    if (!o.quiet && (done % 10 == 0 || done == total)) {
+      std::fprintf(stderr, "warning_study: %zu/%zu services\n", done, total);
+    }
+  });
+  auto json = an::StudyJson(in, r, 0.0);
+  if (!o.lead_sweep_ms.empty()) {
+    nlohmann::ordered_json rows = nlohmann::ordered_json::array();
+    for (const std::int64_t lead : o.lead_sweep_ms) {
+      an::StudyInputs li = in;
+      li.request_lead_ms = lead;
+      const an::StudyResult lr = an::RunStudy(li);
+      if (!o.quiet) {
+        std::fprintf(stderr, "warning_study: request lead %.1f s done\n", static_cast<double>(lead) / 1000.0);
+      }
+      rows.push_back(an::LeadSensitivityRow(lr, lead));
+    }
+    json["sensitivity_request_lead"] = rows;
+  }
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  json["statistics"]["wall_s"] = std::round(wall * 1000.0) / 1000.0;
+  railproof::offline::WriteFileAtomic(o.json, json.dump(1) + "\n");
+  if (!o.svg_dir.empty()) {
+    std::filesystem::create_directories(o.svg_dir);
+    for (an::Method m : {an::Method::kTreadle, an::Method::kOnboard, an::Method::kOnboardDwell, an::Method::kOnboardApproach,
+                         an::Method::kGnss, an::Method::kGnssReceiveTime}) {
+      railproof::offline::WriteFileAtomic(std::filesystem::path(o.svg_dir) / (std::string("warning_time_") + an::ToString(m) + ".svg"),
+                                      an::HistogramSvg(r, m, line.name));
+    }
+  }
+  std::printf("%-30s %6s %7s %7s %7s %7s %8s %6s %7s\n", "method", "n", "min_s", "p05_s", "median", "max_s", "45-74s", "below",
+              "braked");
+  for (an::Method m : {an::Method::kTreadle, an::Method::kOnboard, an::Method::kOnboardDwell, an::Method::kOnboardApproach,
+                       an::Method::kGnss, an::Method::kGnssReceiveTime}) {
+    const an::WarningStats s = an::ComputeStats(r.passages, m);
+    std::size_t braked = 0;
+    for (const auto& p : r.passages) {
+      braked += p.braked[static_cast<std::size_t>(m)] ? 1U : 0U;
+    }
+    std::printf("%-30s %6zu %7.1f %7.1f %7.1f %7.1f %7.0f%% %6zu %7s\n", an::ToString(m), s.count, s.min_s, s.p05_s, s.p50_s,
+                s.max_s, s.share_45_74 * 100.0, s.below_design, an::IsOnboard(m) ? std::to_string(braked).c_str() : "-");
+  }
+  bool pass = an::StudyPasses(r);
+  for (const auto& p : r.passages) {
+    for (an::Method m : {an::Method::kOnboard, an::Method::kOnboardDwell, an::Method::kOnboardApproach, an::Method::kGnss}) {
+      const double w = p.warning_ms[static_cast<std::size_t>(m)];
+      if (w < static_cast<double>(p.design_ms)) {
+        std::fprintf(stderr, "warning_study: SHORT WARNING: %s, service %s (%s), crossing %s: %.1f s < design %.1f s\n", an::ToString(m),
+                     p.service.c_str(), p.running_line.c_str(), p.crossing.c_str(), w / 1000.0,
+                     static_cast<double>(p.design_ms) / 1000.0);
+      }
+    }
+    if (p.braked[static_cast<std::size_t>(an::Method::kOnboardDwell)]) {
+      std::fprintf(stderr, "warning_study: BRAKED: service %s (%s) by the protection pattern of crossing %s\n", p.service.c_str(),
+                   p.running_line.c_str(), p.crossing.c_str());
+    }
+  }
+  std::printf("%zu passages of %zu services, %.1f s: %s\n", r.passages.size(), tt.services.size(), wall, pass ? "PASS" : "FAIL");
+  return pass ? 0 : 1;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    return Main(argc, argv);
+  } catch (const InputError& e) {
+    std::fprintf(stderr, "warning_study: %s\n", e.what());
+    return 2;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "warning_study: error: %s\n", e.what());
+    return 2;
+  }
+}

@@ -1,0 +1,521 @@
+// Wheel-rail scenario loader (spec/wheelrail/README.md): every failure names the file, the
+// entry and the reason.
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "railproof/offline/json_reader.hpp"
+#include "railproof/ra/analysis/wheel_rail.hpp"
+
+namespace railproof::ra::analysis {
+
+namespace {
+
+// Number in [lo, hi] (inclusive).
+double Ranged(const JsonNode& n, double lo, double hi, const std::string& unit = "") {
+  const double v = n.Number();
+  if (v < lo || v > hi) {
+    std::ostringstream os;
+    os << "value " << v << unit << " outside [" << lo << ", " << hi << "]" << unit;
+    n.Fail(os.str());
+  }
+  return v;
+}
+
+double RangedKey(const JsonNode& n, std::string_view key, double def, double lo, double hi) {
+  const auto k = n.OptKey(key);
+  return k ? Ranged(*k, lo, hi) : def;
+}
+
+// "REQ-" + 2..3 capitals + "-" + 3 digits (std::regex avoided: g++ 12 false warnings).
+bool IsRequirementId(const std::string& id) {
+  if (id.size() < 10 || id.size() > 11 || id.rfind("REQ-", 0) != 0) {
+    return false;
+  }
+  const std::size_t dash = id.find('-', 4);
+  if (dash != 6 && dash != 7) {
+    return false;
+  }
+  for (std::size_t i = 4; i < dash; ++i) {
+    if (id[i] < 'A' || id[i] > 'Z') {
+      return false;
+    }
+  }
+  if (id.size() - dash - 1 != 3) {
+    return false;
+  }
+  for (std::size_t i = dash + 1; i < id.size(); ++i) {
+    if (id[i] < '0' || id[i] > '9') {
+      return false;
+    }
+  }
+  return true;
+}
+
+std::string Fmt(double v) {
+  std::ostringstream os;
+  os << v;
+  return os.str();
+}
+
+void ParseVertical(const JsonNode& n, WheelRailScenario& sc) {
+  n.AllowOnly({"begin_m", "end_m", "vertical_curve_radius_m", "gradients"});
+  auto& v = sc.vertical;
+  v.begin_m = Ranged(n.Key("begin_m"), -1e7, 1e7);
+  v.end_m = Ranged(n.Key("end_m"), -1e7, 1e7);
+  if (v.end_m - v.begin_m < 100.0) {
+    n.Key("end_m").Fail("must be at least 100 m beyond begin_m");
+  }
+  v.vertical_curve_radius_m = RangedKey(n, "vertical_curve_radius_m", 3000.0, 500.0, 100000.0);
+  const auto arr = n.Key("gradients").Array();
+  if (arr.empty()) {
+    n.Key("gradients").Fail("at least one gradient expected");
+  }
+  for (const auto& e : arr) {
+    e.AllowOnly({"from_m", "permille", "note"});
+    GradientPoint g;
+    g.from_m = e.Key("from_m").Number();
+    const auto pn = e.Key("permille");
+    g.permille = pn.Number();
+    if (std::fabs(g.permille) > kMaxGradientPermille) {
+      pn.Fail("gradient " + Fmt(g.permille) + " permille beyond the maximum +-35 permille");
+    }
+    g.entry = e.Path();
+    if (v.gradients.empty()) {
+      if (g.from_m != v.begin_m) {
+        e.Key("from_m").Fail("the first gradient must start at vertical.begin_m (" + Fmt(v.begin_m) + ")");
+      }
+    } else if (g.from_m <= v.gradients.back().from_m) {
+      e.Key("from_m").Fail("not after the previous gradient's from_m");
+    } else if (g.from_m >= v.end_m) {
+      e.Key("from_m").Fail("at or beyond vertical.end_m");
+    }
+    v.gradients.push_back(g);
+  }
+  // Vertical curves must fit between the change points and inside the alignment.
+  double prev_end = v.begin_m;
+  for (std::size_t i = 1; i < v.gradients.size(); ++i) {
+    const double h = v.vertical_curve_radius_m *
+                     std::fabs(v.gradients[i].permille - v.gradients[i - 1].permille) / 2000.0;
+    const double c = v.gradients[i].from_m;
+    if (c - h < prev_end - 1e-9) {
+      arr[i].Fail("the vertical curve (" + Fmt(2 * h) + " m) overlaps the previous curve or the alignment start");
+    }
+    prev_end = c + h;
+  }
+  if (prev_end > v.end_m) {
+    arr.back().Fail("the vertical curve extends beyond vertical.end_m");
+  }
+}
+
+void ParseCurves(const JsonNode& n, WheelRailScenario& sc) {
+  for (const auto& e : n.Array()) {
+    e.AllowOnly({"begin_m", "end_m", "radius_m", "cant_mm", "transition_m", "note"});
+    HorizontalCurve c;
+    c.begin_m = e.Key("begin_m").Number();
+    c.end_m = e.Key("end_m").Number();
+    if (c.end_m <= c.begin_m) {
+      e.Key("end_m").Fail("not after begin_m");
+    }
+    const auto rn = e.Key("radius_m");
+    c.radius_m = rn.Number();
+    if (std::fabs(c.radius_m) < 100.0 || std::fabs(c.radius_m) > 100000.0) {
+      rn.Fail("|radius| must be in [100, 100000] m (sign: + left)");
+    }
+    c.cant_mm = RangedKey(e, "cant_mm", 0.0, 0.0, 180.0);
+    c.transition_m = RangedKey(e, "transition_m", 0.0, 0.0, 1000.0);
+    if (2.0 * c.transition_m > c.end_m - c.begin_m) {
+      e.Key("transition_m").Fail("two transitions longer than the curve");
+    }
+    if (!sc.curves.empty() && c.begin_m < sc.curves.back().end_m) {
+      e.Key("begin_m").Fail("overlaps the previous curve (curves sorted, not overlapping)");
+    }
+    c.entry = e.Path();
+    sc.curves.push_back(c);
+  }
+}
+
+void ParseRail(const JsonNode& n, WheelRailScenario& sc) {
+  n.AllowOnly({"condition", "zones"});
+  const auto cn = n.Key("condition");
+  const std::string cond = cn.String();
+  if (cond == "wet") {
+    sc.rail.wet = true;
+  } else if (cond == "dry") {
+    sc.rail.wet = false;
+  } else {
+    cn.Fail("expected 'dry' or 'wet', got '" + cond + "'");
+  }
+  if (const auto z = n.OptKey("zones")) {
+    for (const auto& e : z->Array()) {
+      e.AllowOnly({"begin_m", "end_m", "factor", "from_s", "to_s", "note"});
+      AdhesionZone a;
+      a.begin_m = e.Key("begin_m").Number();
+      a.end_m = e.Key("end_m").Number();
+      if (a.end_m <= a.begin_m) {
+        e.Key("end_m").Fail("not after begin_m");
+      }
+      a.factor = Ranged(e.Key("factor"), 0.05, 1.0);
+      if (const auto f = e.OptKey("from_s")) {
+        a.from_s = Ranged(*f, 0.0, 1e6);
+      }
+      if (const auto t = e.OptKey("to_s")) {
+        a.to_s = Ranged(*t, 0.0, 1e6);
+        if (a.from_s && *a.to_s <= *a.from_s) {
+          t->Fail("not after from_s");
+        }
+      }
+      if (const auto note = e.OptKey("note")) {
+        a.note = note->String();
+      }
+      a.entry = e.Path();
+      sc.rail.zones.push_back(a);
+    }
+  }
+}
+
+void ParseAdhesion(const JsonNode& n, WheelRailScenario& sc) {
+  n.AllowOnly({"wet_factor", "peak_creep", "tail_creep", "tail_ratio", "creep_floor_mps"});
+  auto& a = sc.adhesion;
+  a.wet_factor = RangedKey(n, "wet_factor", a.wet_factor, 0.1, 1.0);
+  a.peak_creep = RangedKey(n, "peak_creep", a.peak_creep, 0.001, 0.1);
+  a.tail_creep = RangedKey(n, "tail_creep", a.tail_creep, 0.01, 1.0);
+  a.tail_ratio = RangedKey(n, "tail_ratio", a.tail_ratio, 0.1, 1.0);
+  a.creep_floor_mps = RangedKey(n, "creep_floor_mps", a.creep_floor_mps, 0.05, 2.0);
+  if (a.tail_creep <= a.peak_creep) {
+    n.Key("tail_creep").Fail("must exceed peak_creep");
+  }
+}
+
+void ParseVehicle(const JsonNode& n, WheelRailScenario& sc) {
+  n.AllowOnly({"length_m", "bogie_centres_m", "axle_spacing_m", "wheel_diameter_m", "body_mass_kg",
+               "bogie_mass_kg", "wheelset_mass_kg", "wheelset_inertia_kgm2", "body_cog_height_m",
+               "primary_hz", "primary_damping", "secondary_hz", "secondary_damping", "roll_coefficient",
+               "motored", "max_traction_force_n", "max_power_w", "max_brake_force_n", "resistance_a_n",
+               "resistance_b_ns_m", "resistance_c_ns2_m2", "max_speed_kmh"});
+  auto& v = sc.vehicle;
+  v.length_m = RangedKey(n, "length_m", v.length_m, 5.0, 40.0);
+  v.bogie_centres_m = RangedKey(n, "bogie_centres_m", v.bogie_centres_m, 3.0, 30.0);
+  v.axle_spacing_m = RangedKey(n, "axle_spacing_m", v.axle_spacing_m, 1.5, 4.0);
+  if (v.bogie_centres_m + v.axle_spacing_m > v.length_m) {
+    n.Fail("bogie_centres_m + axle_spacing_m exceed length_m");
+  }
+  if (v.axle_spacing_m >= v.bogie_centres_m) {
+    n.Fail("axle_spacing_m must be below bogie_centres_m");
+  }
+  v.wheel_diameter_m = RangedKey(n, "wheel_diameter_m", v.wheel_diameter_m, 0.5, 1.5);
+  v.body_mass_kg = RangedKey(n, "body_mass_kg", v.body_mass_kg, 5000.0, 80000.0);
+  v.bogie_mass_kg = RangedKey(n, "bogie_mass_kg", v.bogie_mass_kg, 500.0, 10000.0);
+  v.wheelset_mass_kg = RangedKey(n, "wheelset_mass_kg", v.wheelset_mass_kg, 300.0, 5000.0);
+  v.wheelset_inertia_kgm2 = RangedKey(n, "wheelset_inertia_kgm2", v.wheelset_inertia_kgm2, 10.0, 2000.0);
+  v.body_cog_height_m = RangedKey(n, "body_cog_height_m", v.body_cog_height_m, 1.0, 3.0);
+  v.primary_hz = RangedKey(n, "primary_hz", v.primary_hz, 2.0, 15.0);
+  v.primary_damping = RangedKey(n, "primary_damping", v.primary_damping, 0.0, 1.0);
+  v.secondary_hz = RangedKey(n, "secondary_hz", v.secondary_hz, 0.5, 3.0);
+  v.secondary_damping = RangedKey(n, "secondary_damping", v.secondary_damping, 0.0, 1.0);
+  v.roll_coefficient = RangedKey(n, "roll_coefficient", v.roll_coefficient, 0.0, 0.5);
+  if (const auto m = n.OptKey("motored")) {
+    const auto arr = m->Array();
+    if (arr.size() != kWheelRailAxles) {
+      m->Fail("expected 4 booleans (axle 0 leads)");
+    }
+    for (std::size_t i = 0; i < arr.size(); ++i) {
+      v.motored[i] = arr[i].Bool();
+    }
+  }
+  v.max_traction_force_n = RangedKey(n, "max_traction_force_n", v.max_traction_force_n, 0.0, 100000.0);
+  v.max_power_w = RangedKey(n, "max_power_w", v.max_power_w, 1000.0, 2e6);
+  v.max_brake_force_n = RangedKey(n, "max_brake_force_n", v.max_brake_force_n, 0.0, 100000.0);
+  v.resistance_a_n = RangedKey(n, "resistance_a_n", v.resistance_a_n, 0.0, 20000.0);
+  v.resistance_b_ns_m = RangedKey(n, "resistance_b_ns_m", v.resistance_b_ns_m, 0.0, 2000.0);
+  v.resistance_c_ns2_m2 = RangedKey(n, "resistance_c_ns2_m2", v.resistance_c_ns2_m2, 0.0, 200.0);
+  v.max_speed_kmh = RangedKey(n, "max_speed_kmh", v.max_speed_kmh, 10.0, 300.0);
+}
+
+void ParseDriver(const JsonNode& n, WheelRailScenario& sc) {
+  const auto arr = n.Array();
+  if (arr.empty()) {
+    n.Fail("at least one driver command expected");
+  }
+  for (const auto& e : arr) {
+    e.AllowOnly({"t_s", "traction", "brake", "ramp_s", "hold_kmh", "note"});
+    DriverCommand d;
+    const auto tn = e.Key("t_s");
+    d.t_s = Ranged(tn, 0.0, 1e6);
+    if (!sc.driver.empty() && d.t_s < sc.driver.back().t_s) {
+      tn.Fail("before the previous command (commands sorted by t_s)");
+    }
+    d.traction = RangedKey(e, "traction", 0.0, 0.0, 1.0);
+    d.brake = RangedKey(e, "brake", 0.0, 0.0, 1.0);
+    if (d.traction > 0.0 && d.brake > 0.0 && !e.Has("hold_kmh")) {
+      e.Fail("traction and brake both demanded (only with hold_kmh, as limits)");
+    }
+    d.ramp_s = RangedKey(e, "ramp_s", 1.0, 0.0, 60.0);
+    if (const auto h = e.OptKey("hold_kmh")) {
+      d.hold_kmh = Ranged(*h, 0.0, 300.0);
+    }
+    d.entry = e.Path();
+    sc.driver.push_back(d);
+  }
+}
+
+void ParseSlipControl(const JsonNode& n, WheelRailScenario& sc) {
+  n.AllowOnly({"enabled", "creep_threshold", "reduce_per_s", "recover_per_s", "min_factor"});
+  auto& s = sc.slip_control;
+  s.enabled = n.Key("enabled").Bool();
+  s.creep_threshold = RangedKey(n, "creep_threshold", s.creep_threshold, 0.005, 0.5);
+  s.reduce_per_s = RangedKey(n, "reduce_per_s", s.reduce_per_s, 0.01, 100.0);
+  s.recover_per_s = RangedKey(n, "recover_per_s", s.recover_per_s, 0.01, 100.0);
+  s.min_factor = RangedKey(n, "min_factor", s.min_factor, 0.0, 1.0);
+}
+
+void ParseImu(const JsonNode& n, WheelRailScenario& sc) {
+  n.AllowOnly({"enabled", "accel_bias_mps2", "accel_noise_mps2", "accel_drift_mps2_per_sqrt_s", "rate_bias_deg_s",
+               "rate_noise_deg_s", "rate_drift_deg_s_per_sqrt_s"});
+  auto& m = sc.imu;
+  if (const auto e = n.OptKey("enabled")) {
+    m.enabled = e->Bool();
+  }
+  m.accel_bias_mps2 = RangedKey(n, "accel_bias_mps2", m.accel_bias_mps2, 0.0, 1.0);
+  m.accel_noise_mps2 = RangedKey(n, "accel_noise_mps2", m.accel_noise_mps2, 0.0, 2.0);
+  m.accel_drift_mps2_per_sqrt_s = RangedKey(n, "accel_drift_mps2_per_sqrt_s", m.accel_drift_mps2_per_sqrt_s, 0.0, 0.01);
+  m.rate_bias_deg_s = RangedKey(n, "rate_bias_deg_s", m.rate_bias_deg_s, 0.0, 1.0);
+  m.rate_noise_deg_s = RangedKey(n, "rate_noise_deg_s", m.rate_noise_deg_s, 0.0, 5.0);
+  m.rate_drift_deg_s_per_sqrt_s = RangedKey(n, "rate_drift_deg_s_per_sqrt_s", m.rate_drift_deg_s_per_sqrt_s, 0.0, 0.01);
+}
+
+void ParseTg(const JsonNode& n, WheelRailScenario& sc) {
+  n.AllowOnly({"axle", "teeth", "calibration_error_ppm"});
+  if (const auto a = n.OptKey("axle")) {
+    const auto v = a->Int();
+    if (v < 0 || v >= kWheelRailAxles) {
+      a->Fail("axle must be 0..3");
+    }
+    sc.tg.axle = static_cast<int>(v);
+  }
+  if (const auto t = n.OptKey("teeth")) {
+    const auto v = t->Int();
+    if (v < 1 || v > 1000) {
+      t->Fail("teeth must be 1..1000");
+    }
+    sc.tg.teeth = static_cast<int>(v);
+  }
+  sc.tg.calibration_error_ppm = RangedKey(n, "calibration_error_ppm", 0.0, -20000.0, 20000.0);
+}
+
+SensorFaultKind FaultKind(const JsonNode& n) {
+  const std::string t = n.String();
+  for (const auto k : {SensorFaultKind::kTgDropout, SensorFaultKind::kTgStuck, SensorFaultKind::kTgBurst,
+                       SensorFaultKind::kTgEdgeInvalid, SensorFaultKind::kImuNan, SensorFaultKind::kImuGap,
+                       SensorFaultKind::kImuTimestamps, SensorFaultKind::kImuOutOfRange,
+                       SensorFaultKind::kCycleTime}) {
+    if (t == ToString(k)) {
+      return k;
+    }
+  }
+  n.Fail("unknown fault type '" + t +
+         "' (tg_dropout, tg_stuck, tg_burst, tg_edge_invalid, imu_nan, imu_gap, imu_timestamps, "
+         "imu_out_of_range, cycle_time)");
+}
+
+void ParseFaults(const JsonNode& n, WheelRailScenario& sc) {
+  for (const auto& e : n.Array()) {
+    e.AllowOnly({"type", "from_s", "to_s", "samples", "pulses", "value", "note"});
+    SensorFault f;
+    f.kind = FaultKind(e.Key("type"));
+    f.from_s = Ranged(e.Key("from_s"), 0.0, 1e6);
+    const auto tn = e.Key("to_s");
+    f.to_s = tn.Number();
+    if (f.to_s <= f.from_s) {
+      tn.Fail("not after from_s (negative or zero duration)");
+    }
+    if (f.from_s >= sc.duration_s) {
+      e.Key("from_s").Fail("at or after the end of the scenario (duration_s " + Fmt(sc.duration_s) + ")");
+    }
+    if (const auto s = e.OptKey("samples")) {
+      if (f.kind != SensorFaultKind::kImuGap) {
+        s->Fail("only for imu_gap");
+      }
+      const auto v = s->Int();
+      if (v < 0 || v >= ra::kImuSamplesPerCycle) {
+        s->Fail("delivered samples must be 0..9");
+      }
+      f.samples = static_cast<int>(v);
+    }
+    if (const auto p = e.OptKey("pulses")) {
+      if (f.kind != SensorFaultKind::kTgBurst) {
+        p->Fail("only for tg_burst");
+      }
+      f.pulses = p->Int();
+      if (f.pulses < 1 || f.pulses > 1000000) {
+        p->Fail("pulses must be 1..1000000");
+      }
+    }
+    if (const auto v = e.OptKey("value")) {
+      if (f.kind != SensorFaultKind::kImuOutOfRange) {
+        v->Fail("only for imu_out_of_range");
+      }
+      f.value = v->Number();
+    }
+    if (const auto note = e.OptKey("note")) {
+      f.note = note->String();
+    }
+    f.entry = e.Path();
+    sc.faults.push_back(f);
+  }
+}
+
+void ParseOdometry(const JsonNode& n, WheelRailScenario& sc) {
+  n.AllowOnly({"detect_threshold_mm_s2", "max_compensation_s", "start_points", "rate_error_udeg_s"});
+  if (const auto t = n.OptKey("detect_threshold_mm_s2")) {
+    sc.odometry.detect_threshold_mm_s2 = std::llround(Ranged(*t, 50.0, 2000.0));
+  }
+  if (const auto t = n.OptKey("max_compensation_s")) {
+    const double s = Ranged(*t, 3.0, 32.0);
+    const auto ms = std::llround(s * 1000.0);
+    if (ms % 100 != 0) {
+      t->Fail("must be a whole number of 100 ms cycles");
+    }
+    sc.odometry.max_compensation_ms = ms;
+  }
+  if (const auto t = n.OptKey("start_points")) {
+    const auto v = t->Int();
+    if (v < 1 || v > 2) {
+      t->Fail("start_points must be 1 or 2");
+    }
+    sc.odometry.start_points = static_cast<int>(v);
+  }
+  if (const auto t = n.OptKey("rate_error_udeg_s")) {
+    sc.odometry.rate_error_udeg_s = std::llround(Ranged(*t, 0.0, 1e6));
+  }
+}
+
+}  // namespace
+
+WheelRailScenario ParseWheelRailScenario(std::string_view text, const std::string& file) {
+  const nlohmann::json doc = JsonNode::Parse(text, file);
+  const JsonNode root(doc, "", file);
+  root.AllowOnly({"schema", "name", "description", "requirements", "expect_safe_reaction", "duration_s", "step_ms",
+                  "seed", "initial_front_m", "initial_speed_kmh", "vertical", "curves", "rail", "adhesion",
+                  "balises", "vehicle", "driver", "slip_control", "imu", "tg", "faults", "truth", "odometry"});
+  WheelRailScenario sc;
+  sc.file = file;
+  const auto schema = root.Key("schema");
+  if (schema.String() != kWheelRailSchema) {
+    schema.Fail("expected '" + std::string(kWheelRailSchema) + "', got '" + schema.String() + "'");
+  }
+  sc.name = root.Key("name").String();
+  if (sc.name.empty()) {
+    root.Key("name").Fail("empty name");
+  }
+  if (const auto d = root.OptKey("description")) {
+    sc.description = d->String();
+  }
+  const auto reqs = root.Key("requirements");
+  for (const auto& r : reqs.Array()) {
+    const std::string id = r.String();
+    if (!IsRequirementId(id)) {
+      r.Fail("not a requirement id: '" + id + "'");
+    }
+    sc.requirements.push_back(id);
+  }
+  if (sc.requirements.empty()) {
+    reqs.Fail("name at least one requirement exercised");
+  }
+  if (const auto e = root.OptKey("expect_safe_reaction")) {
+    sc.expect_safe_reaction = e->Bool();
+  }
+  const auto dn = root.Key("duration_s");
+  sc.duration_s = dn.Number();
+  if (sc.duration_s <= 0.0 || sc.duration_s > 3600.0) {
+    dn.Fail("duration must be in (0, 3600] s, got " + Fmt(sc.duration_s));
+  }
+  if (std::fabs(sc.duration_s * 10.0 - std::round(sc.duration_s * 10.0)) > 1e-9) {
+    dn.Fail("duration must be a whole number of 100 ms cycles");
+  }
+  if (const auto st = root.OptKey("step_ms")) {
+    const double ms = Ranged(*st, 0.1, 5.0);
+    sc.step_us = std::llround(ms * 1000.0);
+    if (std::fabs(ms * 1000.0 - static_cast<double>(sc.step_us)) > 1e-6 || 10000 % sc.step_us != 0) {
+      st->Fail("step must divide the 10 ms IMU sample period in whole microseconds");
+    }
+  }
+  if (const auto s = root.OptKey("seed")) {
+    const auto v = s->Int();
+    if (v < 0) {
+      s->Fail("seed must be >= 0");
+    }
+    sc.seed = static_cast<std::uint64_t>(v);
+  }
+  if (const auto a = root.OptKey("adhesion")) {
+    ParseAdhesion(*a, sc);
+  }
+  if (const auto v = root.OptKey("vehicle")) {
+    ParseVehicle(*v, sc);
+  }
+  ParseVertical(root.Key("vertical"), sc);
+  if (const auto c = root.OptKey("curves")) {
+    ParseCurves(*c, sc);
+  }
+  ParseRail(root.Key("rail"), sc);
+  const auto fn = root.Key("initial_front_m");
+  sc.initial_front_m = fn.Number();
+  if (sc.initial_front_m - sc.vehicle.length_m < sc.vertical.begin_m + 10.0 || sc.initial_front_m >= sc.vertical.end_m) {
+    fn.Fail("the train (front " + Fmt(sc.initial_front_m) + " m, length " + Fmt(sc.vehicle.length_m) +
+            " m) must stand inside the vertical alignment with 10 m behind its rear");
+  }
+  sc.initial_speed_kmh = RangedKey(root, "initial_speed_kmh", 0.0, 0.0, sc.vehicle.max_speed_kmh);
+  if (const auto b = root.OptKey("balises")) {
+    for (const auto& e : b->Array()) {
+      e.AllowOnly({"id", "position_m"});
+      BalisePoint p;
+      p.id = e.Key("id").String();
+      const auto pn = e.Key("position_m");
+      p.position_m = pn.Number();
+      if (p.position_m < sc.vertical.begin_m || p.position_m >= sc.vertical.end_m) {
+        pn.Fail("outside the vertical alignment");
+      }
+      if (!sc.balises.empty() && p.position_m <= sc.balises.back().position_m) {
+        pn.Fail("balises must be sorted by position");
+      }
+      sc.balises.push_back(p);
+    }
+  }
+  ParseDriver(root.Key("driver"), sc);
+  if (const auto s = root.OptKey("slip_control")) {
+    ParseSlipControl(*s, sc);
+  }
+  if (const auto i = root.OptKey("imu")) {
+    ParseImu(*i, sc);
+  }
+  if (const auto t = root.OptKey("tg")) {
+    ParseTg(*t, sc);
+  }
+  if (const auto f = root.OptKey("faults")) {
+    ParseFaults(*f, sc);
+  }
+  if (const auto t = root.OptKey("truth")) {
+    t->AllowOnly({"event_creep", "event_min_s"});
+    sc.truth.event_creep = RangedKey(*t, "event_creep", sc.truth.event_creep, 0.001, 1.0);
+    sc.truth.event_min_s = RangedKey(*t, "event_min_s", sc.truth.event_min_s, 0.0, 60.0);
+  }
+  if (const auto o = root.OptKey("odometry")) {
+    ParseOdometry(*o, sc);
+  }
+  return sc;
+}
+
+WheelRailScenario LoadWheelRailScenario(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    throw offline::InputError(path.string() + ": cannot read");
+  }
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return ParseWheelRailScenario(ss.str(), path.string());
+}
+
+}  // namespace railproof::ra::analysis

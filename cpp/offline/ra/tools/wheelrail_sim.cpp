@@ -1,0 +1,107 @@
+// wheelrail_sim: offline wheel-rail simulation (issue 5): runs a scenario of
+// spec/wheelrail/*.json on the Box2D vehicle model and writes the odometry's sensor
+// streams (TG, IMU, balise per 100 ms cycle) with the truth and the slip/slide events.
+// See spec/wheelrail/README.md.
+//
+// Exit status: 0 done; 2 bad input or error.
+#include <chrono>
+#include <cstdio>
+#include <exception>
+#include <string>
+
+#include "railproof/offline/cli.hpp"
+#include "railproof/offline/output_file.hpp"
+#include "railproof/ra/analysis/wheel_rail.hpp"
+
+namespace {
+
+using railproof::offline::InputError;
+
+void PrintHelp() {
+  std::printf(
+      "usage: wheelrail_sim --scenario FILE [--csv FILE] [--json FILE] [--quiet] [--help]\n"
+      "\n"
+      "Simulates a car (body, two bogies, four wheelsets; Box2D, vertical plane) on the\n"
+      "scenario's vertical alignment with a slip-dependent adhesion law, traction and brake\n"
+      "from the driver schedule, and writes the on-board odometry's sensor streams (TG and\n"
+      "IMU per 100 ms cycle, balise fixes, injected faults) with the truth.\n"
+      "\n"
+      "  --scenario FILE   scenario (format: spec/wheelrail/README.md)\n"
+      "  --csv FILE        one row per cycle: truth, TG, cycle-mean IMU\n"
+      "  --json FILE       every cycle's TG and IMU samples, balise, truth; the slip/slide events\n"
+      "  --quiet           no progress lines on stderr\n"
+      "\n"
+      "Prints a summary (distance, speeds, slip/slide events). Exit status: 0 done, 2 bad\n"
+      "input or error.\n");
+}
+
+struct Options {
+  std::string scenario;
+  std::string csv;
+  std::string json;
+  bool quiet = false;
+};
+
+Options ParseArgs(int argc, char** argv) {
+  Options o;
+  railproof::offline::CliParser cli({.tool = "wheelrail_sim", .unknown = railproof::offline::CliStyle::Unknown::kQuoted},
+                                PrintHelp);
+  cli.Value("--scenario", o.scenario)
+      .Value("--csv", o.csv)
+      .Value("--json", o.json)
+      .Flag("--quiet", o.quiet)
+      .Require("--scenario");
+  cli.ParseOrExit(argc, argv);
+  return o;
+}
+
+int Main(int argc, char** argv) {
+  const Options o = ParseArgs(argc, argv);
+  const auto sc = railproof::ra::analysis::LoadWheelRailScenario(o.scenario);
+  auto progress = [&](double t, double total) {
+    if (!o.quiet) {
+      std::fprintf(stderr, "wheelrail_sim: %s: %.0f / %.0f s simulated\n", sc.name.c_str(), t, total);
+    }
+  };
+  const auto t0 = std::chrono::steady_clock::now();
+  const auto run = railproof::ra::analysis::SimulateWheelRail(sc, progress);
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  if (!o.csv.empty()) {
+    railproof::offline::WriteFileAtomic(o.csv, railproof::ra::analysis::WheelRailCsv(run));
+  }
+  if (!o.json.empty()) {
+    railproof::offline::WriteFileAtomic(o.json, railproof::ra::analysis::WheelRailJson(sc, run).dump(1) + "\n");
+  }
+  double vmax = 0.0;
+  for (const auto& t : run.truth) {
+    vmax = std::max(vmax, t.speed_mps);
+  }
+  const auto& last = run.truth.back();
+  std::printf("%s: %.1f s simulated in %.2f s (%.0fx real time), %zu cycles\n", sc.name.c_str(), run.simulated_s, wall,
+              wall > 0.0 ? run.simulated_s / wall : 0.0, run.cycles.size());
+  std::printf("  distance %.2f m (TG wheel %.2f m), final speed %.2f km/h, max %.2f km/h\n", last.distance_m,
+              last.tg_distance_m, last.speed_mps * 3.6, vmax * 3.6);
+  std::printf("  %zu slip/slide event(s) (|creep| > %.3f for >= %.2f s)\n", run.events.size(), sc.truth.event_creep,
+              sc.truth.event_min_s);
+  for (const auto& e : run.events) {
+    std::printf("    axle %d%s %-5s %7.2f .. %7.2f s (%5.2f s) peak creep %+.3f, front %.1f .. %.1f m\n", e.axle,
+                e.tg_axle ? " (TG)" : "     ", railproof::ra::analysis::ToString(e.kind), static_cast<double>(e.start_ms) / 1000.0,
+                static_cast<double>(e.end_ms) / 1000.0, static_cast<double>(e.end_ms - e.start_ms) / 1000.0,
+                e.peak_creep, e.start_front_m, e.end_front_m);
+  }
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    return Main(argc, argv);
+  } catch (const InputError& e) {
+    std::fprintf(stderr, "wheelrail_sim: %s\n", e.what());
+    return 2;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "wheelrail_sim: error: %s\n", e.what());
+    return 2;
+  }
+}

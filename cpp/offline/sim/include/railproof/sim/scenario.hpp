@@ -1,0 +1,120 @@
+// Scenario files of the line simulation (spec/scenarios/*.json, format in
+// spec/scenarios/README.md, schema spec/schemas/scenario.schema.json). Offline module:
+// LoadScenario throws InputError with a one-line message naming the file and the entry.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "railproof/offline/dynamics.hpp"
+#include "railproof/offline/line.hpp"
+
+namespace railproof::sim {
+
+// the shared offline pieces (line and train data, JSON, plots, command line)
+using namespace ::railproof::offline;  // NOLINT(google-build-using-namespace)
+
+inline constexpr std::string_view kScenarioSchema = "railproof/scenario/1";
+
+struct StopSpec {
+  std::string station;
+  std::int64_t dwell_ms = 0;
+};
+
+struct TrainSpec {
+  std::uint16_t id = 0;  // radio address of the on-board unit; never the ground's id
+  TrainPerformance performance;
+  std::int64_t initial_front_mm = 0;
+  std::int64_t enter_ms = 0;   // registered with the ground (entry balise) at this time
+  std::int64_t depart_ms = 0;  // leaves its initial position at this time (>= enter_ms)
+  std::vector<StopSpec> stops;
+  std::optional<double> speed_cap_mps;  // e.g. a leader limited to 20 km/h
+  std::string entry;                    // path in the file, for messages ("trains[1]")
+};
+
+enum class FaultType : std::uint8_t {
+  kRadioLoss,      // both directions of one train's radio link lost in [from, to)
+  kTrackingLoss,   // the on-board unit loses its position: no reports in [from, to), brakes to a stop
+  kPossession,     // possession of [begin, end) requested at from, cancelled at to
+  kSidingRequest,  // the siding (reverse) route requested at from, freed at to
+  kSpeedRestriction,  // temporary speed restriction on [begin, end) requested and confirmed
+                      // at from, cancelled at to (not a fault: an operating event)
+};
+
+const char* ToString(FaultType type);
+
+struct FaultSpec {
+  FaultType type = FaultType::kRadioLoss;
+  std::optional<std::uint16_t> train;  // radio_loss, tracking_loss
+  std::int64_t begin_mm = 0;           // possession, speed_restriction
+  std::int64_t end_mm = 0;             // possession, speed_restriction
+  std::int64_t route = 0;              // siding_request (0: not given)
+  double speed_mps = 0.0;              // speed_restriction
+  std::int64_t from_ms = 0;
+  std::int64_t to_ms = 0;
+  std::string entry;
+};
+
+struct ChannelSpec {
+  double loss_probability = 0.0;     // each telegram independently, seeded PRNG
+  std::int64_t min_delay_ms = 0;     // delay uniform in [min, max]
+  std::int64_t max_delay_ms = 0;
+  double corrupt_probability = 0.0;  // a telegram gets 1..12 symbol errors in one RS block
+};
+
+// Braking supervision stand-in (until the braking issue): see dynamics.hpp Supervision.
+struct SupervisionSpec {
+  double margin_m = 10.0;              // service curve origin short of the stop limit
+  double free_running_s = 1.0;         // included in the service curve
+  double emergency_free_running_s = 0.5;
+};
+
+// Gap measurement between a leader and its follower (the D5 field-test reproduction).
+struct GapSpec {
+  std::uint16_t leader = 0;
+  std::uint16_t follower = 0;
+  std::int64_t from_ms = 0;  // averaging window
+  std::int64_t to_ms = 0;
+};
+
+enum class MarginPolicy : std::uint8_t { kReported, kD2 };
+
+struct Scenario {
+  std::string file;
+  std::string name;
+  std::string description;
+  std::string line;          // line name: <lines-dir>/<line>.json
+  std::string running_line;  // e.g. "up"
+  std::int64_t duration_ms = 0;
+  std::int64_t step_ms = 100;
+  std::uint64_t seed = 1;
+  std::int64_t ground_cycle_ms = 0;   // default: parameter ground_cycle_ms
+  std::int64_t report_period_ms = 0;  // default: parameter report_period_ms
+  MarginPolicy margin_policy = MarginPolicy::kReported;
+  ChannelSpec channel;
+  SupervisionSpec supervision;
+  std::int64_t sample_ms = 1000;  // diagram / time series resolution
+  double handover_secure_ahead_m = 2000.0;  // radio channel secured this far ahead of a train
+  bool boundary_accepted = true;            // the neighbour accepts trains at the system boundary
+  std::vector<TrainSpec> trains;  // after expanding "repeat"
+  std::vector<FaultSpec> faults;
+  std::optional<GapSpec> gap;
+};
+
+// Parses and validates a scenario text (not yet against a line). `file` names it in messages.
+Scenario ParseScenario(std::string_view text, const std::string& file);
+Scenario LoadScenario(const std::filesystem::path& path);
+
+// The scenario's running line of `line`; InputError "<scenario>: running_line: ..." if the
+// line has no such running line or is not the line the scenario names.
+const RunningLine& SelectRunningLine(const Scenario& scenario, const Line& line);
+
+// Checks the scenario against its running line: stations of stops exist and lie ahead
+// in order, initial fronts on the line, possessions on the line, siding route exists.
+void CheckScenarioAgainstLine(const Scenario& scenario, const RunningLine& line);
+
+}  // namespace railproof::sim

@@ -1,0 +1,430 @@
+// Scenario file reader (spec/scenarios/README.md).
+#include "railproof/sim/scenario.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <set>
+#include <sstream>
+#include <string>
+
+#include "railproof/generated/mb_params.hpp"
+#include "railproof/generated/tg_params.hpp"
+#include "railproof/offline/json_reader.hpp"
+
+namespace railproof::sim {
+
+namespace mb = params::mb;
+
+const char* ToString(FaultType type) {
+  switch (type) {
+    case FaultType::kRadioLoss: return "radio_loss";
+    case FaultType::kTrackingLoss: return "tracking_loss";
+    case FaultType::kPossession: return "possession";
+    case FaultType::kSidingRequest: return "siding_request";
+    case FaultType::kSpeedRestriction: return "speed_restriction";
+  }
+  return "invalid";
+}
+
+namespace {
+
+constexpr double kMaxDurationS = 7.0 * 24.0 * 3600.0;
+
+double Positive(const JsonNode& n, double max = std::numeric_limits<double>::max()) {
+  const double v = n.Number();
+  if (!(v > 0.0) || v > max) {
+    n.Fail("must be positive" + (max < std::numeric_limits<double>::max() ? " and at most " + std::to_string(max) : std::string()) +
+           ", got " + std::to_string(v));
+  }
+  return v;
+}
+
+double NonNegative(const JsonNode& n) {
+  const double v = n.Number();
+  if (v < 0.0) {
+    n.Fail("must not be negative, got " + std::to_string(v));
+  }
+  return v;
+}
+
+double Probability(const JsonNode& n) {
+  const double v = n.Number();
+  if (v < 0.0 || v > 1.0) {
+    n.Fail("must be a probability in [0, 1], got " + std::to_string(v));
+  }
+  return v;
+}
+
+std::int64_t SecondsToMs(const JsonNode& n, double s) {
+  if (s > kMaxDurationS) {
+    n.Fail("time " + std::to_string(s) + " s too large");
+  }
+  return static_cast<std::int64_t>(std::llround(s * 1000.0));
+}
+
+std::int64_t MetresToMm(double m) { return static_cast<std::int64_t>(std::llround(m * 1000.0)); }
+
+std::int64_t PositiveMs(const JsonNode& n) {
+  const std::int64_t v = n.Int();
+  if (v <= 0 || v > 3600000) {
+    n.Fail("must be a positive number of milliseconds up to 3600000, got " + std::to_string(v));
+  }
+  return v;
+}
+
+TrainSpec ReadTrain(const JsonNode& n, const std::string& entry) {
+  n.AllowOnly({"id", "length_m", "max_speed_kmh", "accel_mps2", "service_decel_mps2", "emergency_decel_mps2",
+               "initial_front_m", "enter_s", "depart_s", "stops", "speed_cap_kmh", "resistance", "repeat"});
+  TrainSpec t;
+  t.entry = entry;
+  const JsonNode idn = n.Key("id");
+  const std::int64_t id = idn.Int();
+  if (id < 0 || id > 0xFFFF || id == params::tg::ground_id) {
+    idn.Fail("train id must be in 0..65535 and differ from the ground id " + std::to_string(params::tg::ground_id));
+  }
+  t.id = static_cast<std::uint16_t>(id);
+  t.performance.length_m = Positive(n.Key("length_m"), 2000.0);
+  t.performance.max_speed_mps = Positive(n.Key("max_speed_kmh"), 400.0) / 3.6;
+  t.performance.accel_mps2 = Positive(n.Key("accel_mps2"), 5.0);
+  t.performance.service_decel_mps2 = Positive(n.Key("service_decel_mps2"), 5.0);
+  const JsonNode en = n.Key("emergency_decel_mps2");
+  t.performance.emergency_decel_mps2 = Positive(en, 5.0);
+  if (t.performance.emergency_decel_mps2 < t.performance.service_decel_mps2) {
+    en.Fail("emergency deceleration below the service deceleration");
+  }
+  t.initial_front_mm = MetresToMm(NonNegative(n.Key("initial_front_m")));
+  if (auto e = n.OptKey("enter_s")) {
+    t.enter_ms = SecondsToMs(*e, NonNegative(*e));
+  }
+  const JsonNode dn = n.Key("depart_s");
+  t.depart_ms = SecondsToMs(dn, NonNegative(dn));
+  if (t.depart_ms < t.enter_ms) {
+    dn.Fail("departure before the train enters (enter_s)");
+  }
+  if (auto sn = n.OptKey("stops")) {
+    for (const auto& s : sn->Array()) {
+      s.AllowOnly({"station", "dwell_s"});
+      const JsonNode dw = s.Key("dwell_s");
+      t.stops.push_back(StopSpec{s.Key("station").String(), SecondsToMs(dw, NonNegative(dw))});
+    }
+  }
+  if (auto c = n.OptKey("speed_cap_kmh")) {
+    t.speed_cap_mps = Positive(*c, 400.0) / 3.6;
+  }
+  if (auto r = n.OptKey("resistance")) {
+    r->AllowOnly({"a0", "a1", "a2"});
+    t.performance.resistance = Resistance{NonNegative(r->Key("a0")), NonNegative(r->Key("a1")), NonNegative(r->Key("a2"))};
+  }
+  return t;
+}
+
+FaultSpec ReadFault(const JsonNode& n, const std::string& entry) {
+  FaultSpec f;
+  f.entry = entry;
+  const JsonNode tn = n.Key("type");
+  const std::string type = tn.String();
+  if (type == "radio_loss" || type == "tracking_loss") {
+    f.type = type == "radio_loss" ? FaultType::kRadioLoss : FaultType::kTrackingLoss;
+    n.AllowOnly({"type", "train", "from_s", "to_s", "note"});
+    const JsonNode trn = n.Key("train");
+    const std::int64_t id = trn.Int();
+    if (id < 0 || id > 0xFFFF) {
+      trn.Fail("train id out of range 0..65535");
+    }
+    f.train = static_cast<std::uint16_t>(id);
+  } else if (type == "possession") {
+    f.type = FaultType::kPossession;
+    n.AllowOnly({"type", "begin_m", "end_m", "from_s", "to_s", "note"});
+    f.begin_mm = MetresToMm(NonNegative(n.Key("begin_m")));
+    const JsonNode en = n.Key("end_m");
+    f.end_mm = MetresToMm(NonNegative(en));
+    if (f.end_mm <= f.begin_mm) {
+      en.Fail("possession end not after its begin");
+    }
+  } else if (type == "speed_restriction") {
+    f.type = FaultType::kSpeedRestriction;
+    n.AllowOnly({"type", "begin_m", "end_m", "speed_kmh", "from_s", "to_s", "note"});
+    f.begin_mm = MetresToMm(NonNegative(n.Key("begin_m")));
+    const JsonNode en = n.Key("end_m");
+    f.end_mm = MetresToMm(NonNegative(en));
+    if (f.end_mm <= f.begin_mm) {
+      en.Fail("restriction end not after its begin");
+    }
+    f.speed_mps = Positive(n.Key("speed_kmh"), 400.0) / 3.6;
+  } else if (type == "siding_request") {
+    f.type = FaultType::kSidingRequest;
+    n.AllowOnly({"type", "route", "from_s", "to_s", "note"});
+    if (auto r = n.OptKey("route")) {
+      f.route = r->Int();
+      if (f.route <= 0) {
+        r->Fail("route id must be positive");
+      }
+    }
+  } else {
+    tn.Fail("unknown fault type '" + type + "' (radio_loss, tracking_loss, possession, siding_request, speed_restriction)");
+  }
+  const JsonNode fn = n.Key("from_s");
+  f.from_ms = SecondsToMs(fn, NonNegative(fn));
+  const JsonNode ton = n.Key("to_s");
+  f.to_ms = SecondsToMs(ton, NonNegative(ton));
+  if (f.to_ms <= f.from_ms) {
+    ton.Fail("window end not after its start (from_s)");
+  }
+  return f;
+}
+
+}  // namespace
+
+Scenario ParseScenario(std::string_view text, const std::string& file) {
+  const nlohmann::json doc = JsonNode::Parse(text, file);
+  const JsonNode root(doc, "", file);
+  root.AllowOnly({"schema", "name", "description", "line", "running_line", "duration_s", "step_ms", "seed",
+                  "ground_cycle_ms", "report_period_ms", "margin_policy", "channel", "supervision", "sample_ms",
+                  "trains", "faults", "gap", "handover_secure_ahead_m", "boundary_accepted"});
+  Scenario sc;
+  sc.file = file;
+  const JsonNode schema = root.Key("schema");
+  if (schema.String() != kScenarioSchema) {
+    schema.Fail("unsupported schema '" + schema.String() + "', expected '" + std::string(kScenarioSchema) + "'");
+  }
+  sc.name = root.Key("name").String();
+  if (sc.name.empty()) {
+    root.Key("name").Fail("empty name");
+  }
+  if (auto d = root.OptKey("description")) {
+    sc.description = d->String();
+  }
+  sc.line = root.Key("line").String();
+  if (sc.line.empty() || sc.line.find_first_of("/\\") != std::string::npos) {
+    root.Key("line").Fail("line must be a plain line name (file <lines-dir>/<line>.json)");
+  }
+  sc.running_line = root.Key("running_line").String();
+  const JsonNode dur = root.Key("duration_s");
+  sc.duration_ms = SecondsToMs(dur, Positive(dur, kMaxDurationS));
+
+  sc.step_ms = root.Has("step_ms") ? PositiveMs(root.Key("step_ms")) : 100;
+  if (sc.step_ms > 1000) {
+    root.Key("step_ms").Fail("step must be at most 1000 ms");
+  }
+  const JsonNode seed = root.Key("seed");
+  const std::int64_t sv = seed.Int();
+  if (sv < 0) {
+    seed.Fail("seed must not be negative");
+  }
+  sc.seed = static_cast<std::uint64_t>(sv);
+
+  sc.ground_cycle_ms = root.Has("ground_cycle_ms") ? PositiveMs(root.Key("ground_cycle_ms")) : mb::ground_cycle_ms;
+  sc.report_period_ms = root.Has("report_period_ms") ? PositiveMs(root.Key("report_period_ms")) : mb::report_period_ms;
+  for (const auto& [key, value] : {std::pair<const char*, std::int64_t>{"ground_cycle_ms", sc.ground_cycle_ms},
+                                   {"report_period_ms", sc.report_period_ms}}) {
+    if (value % sc.step_ms != 0) {
+      (root.Has(key) ? root.Key(key) : root.Key("step_ms"))
+          .Fail(std::string(key) + " " + std::to_string(value) + " is not a multiple of step_ms " + std::to_string(sc.step_ms));
+    }
+  }
+  if (auto mp = root.OptKey("margin_policy")) {
+    const std::string p = mp->String();
+    if (p == "reported") {
+      sc.margin_policy = MarginPolicy::kReported;
+    } else if (p == "d2") {
+      sc.margin_policy = MarginPolicy::kD2;
+    } else {
+      mp->Fail("unknown margin policy '" + p + "' (reported, d2)");
+    }
+  }
+  if (auto h = root.OptKey("handover_secure_ahead_m")) {
+    sc.handover_secure_ahead_m = NonNegative(*h);
+  }
+  if (auto b = root.OptKey("boundary_accepted")) {
+    sc.boundary_accepted = b->Bool();
+  }
+  if (auto sm = root.OptKey("sample_ms")) {
+    sc.sample_ms = PositiveMs(*sm);
+    if (sc.sample_ms % sc.step_ms != 0) {
+      sm->Fail("sample_ms is not a multiple of step_ms");
+    }
+  }
+
+  {
+    const JsonNode ch = root.Key("channel");
+    ch.AllowOnly({"loss_probability", "min_delay_ms", "max_delay_ms", "corrupt_probability"});
+    sc.channel.loss_probability = Probability(ch.Key("loss_probability"));
+    if (auto c = ch.OptKey("corrupt_probability")) {
+      sc.channel.corrupt_probability = Probability(*c);
+    }
+    const JsonNode mx = ch.Key("max_delay_ms");
+    sc.channel.max_delay_ms = mx.Int();
+    if (auto mn = ch.OptKey("min_delay_ms")) {
+      sc.channel.min_delay_ms = mn->Int();
+      if (sc.channel.min_delay_ms < 0) {
+        mn->Fail("delay must not be negative");
+      }
+    }
+    if (sc.channel.max_delay_ms < sc.channel.min_delay_ms || sc.channel.max_delay_ms > 60000) {
+      mx.Fail("max_delay_ms must lie in [min_delay_ms, 60000], got " + std::to_string(sc.channel.max_delay_ms));
+    }
+  }
+  if (auto sv2 = root.OptKey("supervision")) {
+    sv2->AllowOnly({"margin_m", "free_running_s", "emergency_free_running_s"});
+    if (auto m = sv2->OptKey("margin_m")) {
+      sc.supervision.margin_m = NonNegative(*m);
+    }
+    if (auto m = sv2->OptKey("free_running_s")) {
+      sc.supervision.free_running_s = NonNegative(*m);
+    }
+    if (auto m = sv2->OptKey("emergency_free_running_s")) {
+      sc.supervision.emergency_free_running_s = NonNegative(*m);
+    }
+  }
+
+  {
+    const JsonNode tn = root.Key("trains");
+    const auto nodes = tn.Array();
+    if (nodes.empty()) {
+      tn.Fail("no train");
+    }
+    std::set<std::uint16_t> ids;
+    for (const auto& n : nodes) {
+      const TrainSpec base = ReadTrain(n, n.Path());
+      std::int64_t count = 1;
+      double interval_s = 0.0;
+      if (auto rp = n.OptKey("repeat")) {
+        rp->AllowOnly({"count", "interval_s"});
+        const JsonNode cn = rp->Key("count");
+        count = cn.Int();
+        if (count < 1 || count > 1000) {
+          cn.Fail("count must lie in 1..1000");
+        }
+        interval_s = Positive(rp->Key("interval_s"), kMaxDurationS);
+      }
+      for (std::int64_t k = 0; k < count; ++k) {
+        TrainSpec t = base;
+        const std::int64_t id = std::int64_t{base.id} + k;
+        if (id > 0xFFFF || id == params::tg::ground_id) {
+          n.Key("id").Fail("repeated train id " + std::to_string(id) + " out of range or equal to the ground id");
+        }
+        t.id = static_cast<std::uint16_t>(id);
+        const auto shift = static_cast<std::int64_t>(std::llround(static_cast<double>(k) * interval_s * 1000.0));
+        t.enter_ms += shift;
+        t.depart_ms += shift;
+        if (k > 0) {
+          t.entry = n.Path() + " copy " + std::to_string(k);
+        }
+        if (!ids.insert(t.id).second) {
+          n.Key("id").Fail("duplicate train id " + std::to_string(t.id));
+        }
+        sc.trains.push_back(std::move(t));
+      }
+    }
+  }
+  if (auto fn = root.OptKey("faults")) {
+    for (const auto& n : fn->Array()) {
+      FaultSpec f = ReadFault(n, n.Path());
+      if (f.train && std::none_of(sc.trains.begin(), sc.trains.end(), [&](const TrainSpec& t) { return t.id == *f.train; })) {
+        n.Key("train").Fail("unknown train " + std::to_string(*f.train));
+      }
+      sc.faults.push_back(f);
+    }
+  }
+  if (auto gn = root.OptKey("gap")) {
+    gn->AllowOnly({"leader", "follower", "from_s", "to_s"});
+    GapSpec g;
+    for (auto [key, out] : {std::pair<const char*, std::uint16_t*>{"leader", &g.leader}, {"follower", &g.follower}}) {
+      const JsonNode idn = gn->Key(key);
+      const std::int64_t id = idn.Int();
+      if (std::none_of(sc.trains.begin(), sc.trains.end(), [&](const TrainSpec& t) { return t.id == id; })) {
+        idn.Fail("unknown train " + std::to_string(id));
+      }
+      *out = static_cast<std::uint16_t>(id);
+    }
+    if (g.leader == g.follower) {
+      gn->Key("follower").Fail("follower equals leader");
+    }
+    const JsonNode f = gn->Key("from_s");
+    g.from_ms = SecondsToMs(f, NonNegative(f));
+    const JsonNode t = gn->Key("to_s");
+    g.to_ms = SecondsToMs(t, NonNegative(t));
+    if (g.to_ms <= g.from_ms || g.to_ms > sc.duration_ms) {
+      t.Fail("gap window must end after from_s and within duration_s");
+    }
+    sc.gap = g;
+  }
+  return sc;
+}
+
+Scenario LoadScenario(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    throw InputError(path.string() + ": cannot read scenario file");
+  }
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return ParseScenario(ss.str(), path.string());
+}
+
+const RunningLine& SelectRunningLine(const Scenario& sc, const Line& line) {
+  if (line.name != sc.line) {
+    throw InputError(sc.file + ": line: the scenario names line '" + sc.line + "' but " + line.file + " holds line '" +
+                     line.name + "'");
+  }
+  std::string have;
+  for (const auto& rl : line.running_lines) {
+    if (rl.id == sc.running_line) {
+      return rl;
+    }
+    have += (have.empty() ? "" : ", ") + rl.id;
+  }
+  throw InputError(sc.file + ": running_line: unknown running line '" + sc.running_line + "' on line '" + line.name +
+                   "' (has: " + have + ")");
+}
+
+void CheckScenarioAgainstLine(const Scenario& sc, const RunningLine& line) {
+  const auto fail = [&](const std::string& entry, const std::string& reason) {
+    throw InputError(sc.file + ": " + entry + ": " + reason);
+  };
+  const auto len = line.length_mm;
+  for (const auto& t : sc.trains) {
+    const auto length_mm = static_cast<std::int64_t>(std::llround(t.performance.length_m * 1000.0));
+    if (t.initial_front_mm - length_mm < 0 || t.initial_front_mm > len) {
+      fail(t.entry + ".initial_front_m", "train range [" + std::to_string(t.initial_front_mm - length_mm) + ", " +
+                                             std::to_string(t.initial_front_mm) + ") mm lies off running line '" +
+                                             line.id + "' [0, " + std::to_string(len) + ")");
+    }
+    std::int64_t last = t.initial_front_mm;
+    for (std::size_t i = 0; i < t.stops.size(); ++i) {
+      const Station* st = line.FindStation(t.stops[i].station);
+      const std::string entry = t.entry + ".stops[" + std::to_string(i) + "].station";
+      if (st == nullptr) {
+        std::string have;
+        for (const auto& s : line.stations) {
+          have += (have.empty() ? "" : ", ") + s.name;
+        }
+        fail(entry, "unknown station '" + t.stops[i].station + "' on running line '" + line.id + "' (has: " + have + ")");
+      }
+      if (st->stop_mm < last) {
+        fail(entry, "station '" + st->name + "' (stop at " + std::to_string(st->stop_mm) +
+                        " mm) lies behind the train's previous position " + std::to_string(last) + " mm");
+      }
+      last = st->stop_mm;
+    }
+  }
+  for (const auto& f : sc.faults) {
+    if ((f.type == FaultType::kPossession || f.type == FaultType::kSpeedRestriction) && f.end_mm > len) {
+      fail(f.entry, std::string(ToString(f.type)) + " [" + std::to_string(f.begin_mm) + ", " + std::to_string(f.end_mm) +
+                        ") mm lies off running line '" + line.id + "'");
+    }
+    if (f.type == FaultType::kSidingRequest) {
+      const bool found = std::any_of(line.routes.begin(), line.routes.end(), [&](const Route& r) {
+        return f.route != 0 ? r.id == f.route : (r.reverse && !r.automatic);
+      });
+      if (!found) {
+        fail(f.entry, f.route != 0 ? "unknown route " + std::to_string(f.route) + " on running line '" + line.id + "'"
+                                   : "running line '" + line.id + "' has no siding (reverse, non-automatic) route");
+      }
+    }
+  }
+}
+
+}  // namespace railproof::sim

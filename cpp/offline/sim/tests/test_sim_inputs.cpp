@@ -1,0 +1,325 @@
+// Unit tests of the simulation's inputs: line JSON loader (REQ-MB-020), ground line
+// building, scenario files, payload codec.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <sstream>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "railproof/sim/codec.hpp"
+#include "railproof/sim/ground_line.hpp"
+#include "railproof/offline/line.hpp"
+#include "railproof/sim/scenario.hpp"
+
+namespace railproof::sim {
+namespace {
+
+std::filesystem::path DataDir() { return std::filesystem::path(__FILE__).parent_path() / "data"; }
+
+nlohmann::json TestLineJson() {
+  std::ifstream in(DataDir() / "sim_test_line.json");
+  return nlohmann::json::parse(in);
+}
+
+// Expects ParseLine of the mutated test line to fail with a message containing every
+// fragment (file name and entry path first).
+void ExpectLineError(const std::function<void(nlohmann::json&)>& mutate, const std::vector<std::string>& fragments) {
+  nlohmann::json j = TestLineJson();
+  mutate(j);
+  try {
+    (void)ParseLine(j.dump(), "bad_line.json");
+    ADD_FAILURE() << "no error for " << fragments.front();
+  } catch (const InputError& e) {
+    const std::string msg = e.what();
+    EXPECT_EQ(msg.rfind("bad_line.json: ", 0), 0U) << msg;
+    EXPECT_EQ(msg.find('\n'), std::string::npos) << "one line: " << msg;
+    for (const auto& f : fragments) {
+      EXPECT_NE(msg.find(f), std::string::npos) << "'" << f << "' not in: " << msg;
+    }
+  }
+}
+
+nlohmann::json& Up(nlohmann::json& j) { return j["running_lines"][0]; }
+
+// @verifies REQ-MB-020
+TEST(SimLineLoader, LoadsTheTestLine) {
+  const Line line = LoadLine(DataDir() / "sim_test_line.json");
+  EXPECT_EQ(line.name, "sim_test_line");
+  ASSERT_EQ(line.running_lines.size(), 2U);
+  const RunningLine& up = line.Running("up");
+  EXPECT_EQ(up.length_mm, 10'000'000);
+  EXPECT_EQ(up.blocks_mm.size(), 201U);
+  EXPECT_EQ(up.GradientAt(3'500'000), -100);
+  EXPECT_EQ(up.SpeedLimitAt(7'200'000), 60);
+  EXPECT_EQ(up.SpeedLimitAt(10'000'000), 100);
+  ASSERT_NE(up.FindStation("B"), nullptr);
+  EXPECT_EQ(up.FindStation("B")->stop_mm, 8'990'000);
+  EXPECT_EQ(up.FindStation("Z"), nullptr);
+  EXPECT_FALSE(up.system_boundary_mm.has_value());
+  EXPECT_EQ(up.handovers.at(0).position_mm, 6'000'000);
+  EXPECT_EQ(LinePath("/x/lines", "d1_test_line"), std::filesystem::path("/x/lines/d1_test_line.json"));
+}
+
+// @verifies REQ-MB-020
+TEST(SimLineLoader, RejectsUnreadableAndMalformedFiles) {
+  try {
+    (void)LoadLine(DataDir() / "no_such_line.json");
+    ADD_FAILURE();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("no_such_line.json: cannot read"), std::string::npos) << e.what();
+  }
+  try {
+    (void)ParseLine("{\"schema\": ", "trunc.json");
+    ADD_FAILURE();
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("trunc.json: invalid JSON", 0), 0U) << e.what();
+  }
+  ExpectLineError([](auto& j) { j["schema"] = "railproof/line-json/0"; }, {"schema", "unsupported schema"});
+}
+
+// @verifies REQ-MB-020
+TEST(SimLineLoader, RejectsMissingKeysAndWrongTypes) {
+  ExpectLineError([](auto& j) { j.erase("running_lines"); }, {"missing key 'running_lines'"});
+  ExpectLineError([](auto& j) { Up(j).erase("blocks_mm"); }, {"running_lines[0] (up)", "missing key 'blocks_mm'"});
+  ExpectLineError([](auto& j) { Up(j)["length_mm"] = "10 km"; }, {"running_lines[0] (up).length_mm", "expected an integer, got string"});
+  ExpectLineError([](auto& j) { Up(j)["blocks_mm"][3] = 150000.5; }, {"running_lines[0] (up).blocks_mm[3]", "expected an integer"});
+  ExpectLineError([](auto& j) { Up(j)["stations"][0]["fixed_block"] = 1; },
+                  {"running_lines[0] (up).stations[0] (A).fixed_block", "expected true or false"});
+  ExpectLineError([](auto& j) { Up(j)["balises"] = nlohmann::json::object(); }, {"balises", "expected an array"});
+  ExpectLineError([](auto& j) { j["running_lines"] = nlohmann::json::array(); }, {"running_lines", "no running line"});
+  ExpectLineError([](auto& j) { j["running_lines"][1]["id"] = "up"; }, {"running_lines[1].id", "duplicate identifier 'up'"});
+}
+
+// @verifies REQ-MB-020
+TEST(SimLineLoader, RejectsBadGeometry) {
+  ExpectLineError([](auto& j) { std::swap(Up(j)["blocks_mm"][3], Up(j)["blocks_mm"][4]); },
+                  {"running_lines[0] (up).blocks_mm[4]", "not greater than the previous one"});
+  ExpectLineError([](auto& j) { Up(j)["blocks_mm"][0] = 10; }, {"blocks_mm[0]", "first block boundary must be 0"});
+  ExpectLineError([](auto& j) { Up(j)["blocks_mm"].erase(Up(j)["blocks_mm"].size() - 1); },
+                  {"blocks_mm[199]", "must equal length_mm"});
+  ExpectLineError([](auto& j) { Up(j)["gradients"][1]["begin_mm"] = 3'100'000; },
+                  {"running_lines[0] (up).gradients[1]", "begins at 3100000 mm, expected 3000000"});
+  ExpectLineError([](auto& j) { Up(j)["speed_limits"].erase(2); }, {"speed_limits[1]", "must cover the whole line"});
+  ExpectLineError([](auto& j) { Up(j)["radio_cells"] = nlohmann::json::array(); }, {"radio_cells", "must cover the line"});
+  ExpectLineError([](auto& j) { Up(j)["balises"][2]["position_mm"] = 10'000'001; },
+                  {"balises[2] (B3).position_mm", "lies off the line"});
+  ExpectLineError([](auto& j) { Up(j)["stations"][0]["stop_mm"] = 2'100'000; }, {"stations[0] (A).stop_mm", "outside the platform"});
+  ExpectLineError([](auto& j) { Up(j)["points"][0]["end_mm"] = 5'100'000; }, {"points[0] (P1)", "not exactly one virtual block"});
+  ExpectLineError([](auto& j) { Up(j)["routes"][1]["points"] = "P9"; }, {"routes[1] (route 2).points", "unknown points 'P9'"});
+  ExpectLineError([](auto& j) { Up(j)["routes"][1]["id"] = 1; }, {"routes[1].id", "duplicate route id 1"});
+  ExpectLineError([](auto& j) { Up(j)["handovers"][0]["position_mm"] = 5'000'000; },
+                  {"handovers[0] (H1).position_mm", "not at a boundary between two radio cells"});
+  ExpectLineError([](auto& j) { Up(j)["gradients"][0]["end_mm"] = 0; Up(j)["gradients"][0]["begin_mm"] = 0; },
+                  {"gradients[0]", "empty or reversed section"});
+  ExpectLineError([](auto& j) { Up(j)["curves"][0]["radius_m"] = 0; }, {"curves[0].radius_m", "radius must be positive"});
+  ExpectLineError([](auto& j) { Up(j)["system_boundary_mm"] = 0; }, {"system_boundary_mm", "lies off the line"});
+}
+
+// @verifies REQ-MB-020
+TEST(SimLineLoader, RejectsAnUnknownRunningLine) {
+  const Line line = LoadLine(DataDir() / "sim_test_line.json");
+  try {
+    (void)line.Running("sideways");
+    ADD_FAILURE();
+  } catch (const InputError& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find("sim_test_line.json: unknown running line 'sideways' (the line has: up, down)"), std::string::npos)
+        << msg;
+  }
+}
+
+// @verifies REQ-MB-020
+TEST(SimGroundLine, BuildsTheGroundConfigurationAndCreatesTheGround) {
+  const Line line = LoadLine(DataDir() / "sim_test_line.json");
+  const RunningLine& up = line.Running("up");
+  const GroundLine gl = BuildGroundLine(line, up, mb::wayside::MarginPolicy::kReportedCorrection, 500);
+  EXPECT_EQ(gl.config.length_mm, up.length_mm);
+  EXPECT_EQ(gl.config.blocks_mm.size(), up.blocks_mm.size());
+  EXPECT_EQ(gl.fixed_blocks.size(), 2U);
+  EXPECT_EQ(gl.setback_sections.size(), 1U);
+  ASSERT_EQ(gl.routes.size(), 2U);
+  EXPECT_EQ(gl.routes[1].points_index, 0U);
+  EXPECT_TRUE(gl.routes[1].reverse);
+  EXPECT_EQ(gl.handovers.at(0).position_mm, 6'000'000);
+  auto ground = CreateGround(line, up, gl, 3);
+  ASSERT_NE(ground, nullptr);
+  EXPECT_EQ(ground->BlockCount(), 200U);
+}
+
+// @verifies REQ-MB-020
+TEST(SimGroundLine, ALineTheGroundRefusesNamesTheEntry) {
+  nlohmann::json j = TestLineJson();
+  // two fixed-block platforms that overlap: valid JSON shapes, refused by the ground
+  Up(j)["stations"][1]["platform_begin_mm"] = 1'900'000;
+  Up(j)["stations"][1]["platform_end_mm"] = 2'100'000;
+  Up(j)["stations"][1]["stop_mm"] = 2'050'000;
+  const Line line = ParseLine(j.dump(), "overlap.json");
+  const RunningLine& up = line.Running("up");
+  const GroundLine gl = BuildGroundLine(line, up, mb::wayside::MarginPolicy::kReportedCorrection, 500);
+  try {
+    (void)CreateGround(line, up, gl, 2);
+    ADD_FAILURE();
+  } catch (const InputError& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find("overlap.json: running line 'up': the ground refuses the line: FixedBlockInvalid"), std::string::npos)
+        << msg;
+    EXPECT_NE(msg.find("fixed-block platforms[1]"), std::string::npos) << msg;
+  }
+}
+
+// ---- scenario files --------------------------------------------------------------------
+
+nlohmann::json MinimalScenario() {
+  return nlohmann::json::parse(R"({
+    "schema": "railproof/scenario/1", "name": "t", "line": "sim_test_line", "running_line": "up",
+    "duration_s": 60, "step_ms": 100, "seed": 1,
+    "channel": {"loss_probability": 0.0, "max_delay_ms": 0},
+    "trains": [{"id": 2, "length_m": 100, "max_speed_kmh": 100, "accel_mps2": 0.8,
+                "service_decel_mps2": 0.8, "emergency_decel_mps2": 1.2,
+                "initial_front_m": 500, "depart_s": 0}]})");
+}
+
+void ExpectScenarioError(const std::function<void(nlohmann::json&)>& mutate, const std::vector<std::string>& fragments,
+                         bool against_line = false) {
+  nlohmann::json j = MinimalScenario();
+  mutate(j);
+  try {
+    const Scenario sc = ParseScenario(j.dump(), "bad_scenario.json");
+    if (against_line) {
+      const Line line = LoadLine(DataDir() / "sim_test_line.json");
+      CheckScenarioAgainstLine(sc, SelectRunningLine(sc, line));
+    }
+    ADD_FAILURE() << "no error for " << fragments.front();
+  } catch (const InputError& e) {
+    const std::string msg = e.what();
+    EXPECT_EQ(msg.rfind("bad_scenario.json: ", 0), 0U) << msg;
+    EXPECT_EQ(msg.find('\n'), std::string::npos) << msg;
+    for (const auto& f : fragments) {
+      EXPECT_NE(msg.find(f), std::string::npos) << "'" << f << "' not in: " << msg;
+    }
+  }
+}
+
+TEST(SimScenarioFile, ParsesAndFillsDefaultsFromTheParameters) {
+  nlohmann::json j = MinimalScenario();
+  j["trains"][0]["repeat"] = {{"count", 3}, {"interval_s", 120}};
+  j["trains"][0]["stops"] = {{{"station", "A"}, {"dwell_s", 30}}};
+  j["faults"] = {{{"type", "radio_loss"}, {"train", 3}, {"from_s", 10}, {"to_s", 20}},
+                 {{"type", "possession"}, {"begin_m", 7000}, {"end_m", 7400}, {"from_s", 5}, {"to_s", 50}}};
+  const Scenario sc = ParseScenario(j.dump(), "s.json");
+  EXPECT_EQ(sc.ground_cycle_ms, 500);
+  EXPECT_EQ(sc.report_period_ms, 1000);
+  ASSERT_EQ(sc.trains.size(), 3U);
+  EXPECT_EQ(sc.trains[2].id, 4);
+  EXPECT_EQ(sc.trains[2].enter_ms, 240'000);
+  EXPECT_EQ(sc.trains[2].depart_ms, 240'000);
+  EXPECT_EQ(sc.trains[1].stops.at(0).dwell_ms, 30'000);
+  EXPECT_DOUBLE_EQ(sc.trains[0].performance.max_speed_mps, 100.0 / 3.6);
+  ASSERT_EQ(sc.faults.size(), 2U);
+  EXPECT_EQ(sc.faults[1].begin_mm, 7'000'000);
+  EXPECT_EQ(sc.faults[0].type, FaultType::kRadioLoss);
+}
+
+TEST(SimScenarioFile, BadScenarioFilesGiveOneLineErrorsNamingTheEntry) {
+  ExpectScenarioError([](auto& j) { j["trainz"] = 1; }, {"unknown key 'trainz'"});
+  ExpectScenarioError([](auto& j) { j.erase("seed"); }, {"missing key 'seed'"});
+  ExpectScenarioError([](auto& j) { j["channel"]["loss_probability"] = 1.5; }, {"channel.loss_probability", "probability"});
+  ExpectScenarioError([](auto& j) { j["channel"]["max_delay_ms"] = -1; }, {"channel.max_delay_ms"});
+  ExpectScenarioError([](auto& j) { j["trains"][0]["length_m"] = "long"; }, {"trains[0].length_m", "expected a number"});
+  ExpectScenarioError([](auto& j) { j["trains"][0]["id"] = 1; }, {"trains[0].id", "ground id"});
+  ExpectScenarioError([](auto& j) { j["trains"][0]["emergency_decel_mps2"] = 0.5; }, {"trains[0].emergency_decel_mps2"});
+  ExpectScenarioError([](auto& j) { j["trains"][0]["depart_s"] = 5; j["trains"][0]["enter_s"] = 10; },
+                      {"trains[0].depart_s", "before the train enters"});
+  ExpectScenarioError([](auto& j) { j["trains"].push_back(j["trains"][0]); }, {"trains[1].id", "duplicate train id 2"});
+  ExpectScenarioError([](auto& j) { j["faults"] = {{{"type", "meteor"}, {"from_s", 1}, {"to_s", 2}}}; },
+                      {"faults[0].type", "unknown fault type 'meteor'"});
+  ExpectScenarioError([](auto& j) { j["faults"] = {{{"type", "radio_loss"}, {"train", 9}, {"from_s", 1}, {"to_s", 2}}}; },
+                      {"faults[0].train", "unknown train 9"});
+  ExpectScenarioError([](auto& j) { j["faults"] = {{{"type", "radio_loss"}, {"train", 2}, {"from_s", 5}, {"to_s", 2}}}; },
+                      {"faults[0].to_s", "window end not after its start"});
+  ExpectScenarioError([](auto& j) { j["step_ms"] = 300; }, {"ground_cycle_ms 500 is not a multiple of step_ms 300"});
+  ExpectScenarioError([](auto& j) { j["schema"] = "x"; }, {"schema", "unsupported schema"});
+  ExpectScenarioError([](auto& j) { j["gap"] = {{"leader", 2}, {"follower", 2}, {"from_s", 1}, {"to_s", 2}}; },
+                      {"gap.follower", "follower equals leader"});
+  ExpectScenarioError([](auto& j) { j["line"] = "../etc/x"; }, {"line", "plain line name"});
+  // against the line
+  ExpectScenarioError([](auto& j) { j["trains"][0]["stops"] = {{{"station", "Q"}, {"dwell_s", 1}}}; },
+                      {"trains[0].stops[0].station", "unknown station 'Q'", "(has: A, B)"}, true);
+  ExpectScenarioError([](auto& j) { j["trains"][0]["initial_front_m"] = 50; }, {"trains[0].initial_front_m", "lies off"}, true);
+  ExpectScenarioError([](auto& j) { j["running_line"] = "left"; }, {"running_line: unknown running line 'left' on line 'sim_test_line' (has: up, down)"}, true);
+  ExpectScenarioError([](auto& j) { j["line"] = "other_line"; }, {"line: the scenario names line 'other_line'"}, true);
+  ExpectScenarioError([](auto& j) { j["faults"] = {{{"type", "siding_request"}, {"route", 7}, {"from_s", 1}, {"to_s", 2}}}; },
+                      {"faults[0]", "unknown route 7"}, true);
+}
+
+TEST(SimScenarioFile, EveryProvidedScenarioParses) {
+  const auto dir = std::filesystem::path(RAILPROOF_TEST_SOURCE_DIR) / "spec" / "scenarios";
+  std::size_t n = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(dir)) {
+    if (entry.path().extension() != ".json") {
+      continue;
+    }
+    ++n;
+    EXPECT_NO_THROW({
+      const Scenario sc = LoadScenario(entry.path());
+      EXPECT_EQ(sc.name, entry.path().stem().string()) << "file name and scenario name differ";
+    }) << entry.path();
+  }
+  EXPECT_GE(n, 7U);
+}
+
+// ---- payload codec ---------------------------------------------------------------------
+
+TEST(SimCodec, PositionAndStopLimitPayloadsRoundTrip) {
+  messages::PositionReport r{};
+  r.train_id = 7;
+  r.front_block = 12;
+  r.offset_mm = 34'567;
+  r.length_mm = 100'000;
+  r.correction_mm = 321;
+  r.last_balise_mm = 250'000;
+  r.speed_mm_s = 27'777;
+  r.direction = mb::wayside::Direction::kNominal;
+  bool malformed = true;
+  const auto back = DecodePosition(EncodePosition(r), malformed);
+  ASSERT_TRUE(back.has_value());
+  EXPECT_FALSE(malformed);
+  EXPECT_EQ(back->offset_mm, 34'567);
+  EXPECT_EQ(back->speed_mm_s, 27'777);
+  EXPECT_EQ(back->front_block, 12U);
+  EXPECT_FALSE(DecodePosition(EncodeNoPosition(), malformed).has_value());
+  EXPECT_FALSE(malformed);
+  auto bytes = EncodePosition(r);
+  bytes.pop_back();
+  EXPECT_FALSE(DecodePosition(bytes, malformed).has_value());
+  EXPECT_TRUE(malformed);
+
+  messages::StopLimitTelegram t{};
+  t.train_id = 7;
+  t.limit_mm = 1'234'567;
+  t.kind = messages::Obstruction::kPossession;
+  t.issue_time_ms = 99'500;
+  t.restriction_count = 1;
+  t.restrictions[0] = messages::SpeedRestriction{3, 2'000'000, 2'500'000, 8'333};
+  const auto tb = DecodeStopLimit(EncodeStopLimit(t), malformed);
+  ASSERT_TRUE(tb.has_value());
+  EXPECT_EQ(tb->limit_mm, 1'234'567);
+  EXPECT_EQ(tb->kind, messages::Obstruction::kPossession);
+  EXPECT_EQ(tb->issue_time_ms, 99'500);
+  ASSERT_EQ(tb->restriction_count, 1U);
+  EXPECT_EQ(tb->restrictions[0].end_mm, 2'500'000);
+  EXPECT_EQ(tb->restrictions[0].speed_mm_s, 8'333);
+  EXPECT_FALSE(DecodeStopLimit(EncodeKeepAlive(), malformed).has_value());
+  EXPECT_FALSE(malformed);
+  auto tbytes = EncodeStopLimit(t);
+  tbytes.push_back(0);
+  EXPECT_FALSE(DecodeStopLimit(tbytes, malformed).has_value());
+  EXPECT_TRUE(malformed);
+}
+
+}  // namespace
+}  // namespace railproof::sim

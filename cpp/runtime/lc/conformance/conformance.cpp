@@ -1,0 +1,709 @@
+// railproof_conformance_lc: replays the vectors generated from models/lc.pml (every
+// lc*.jsonl of the vector directory) against the C++ level-crossing units,
+// spec/design/lc.md §3-§6: lc::onboard::CrossingProtection (railproof_onboard),
+// lc::wayside::CrossingController and lc::wayside::CentreScheduler (railproof_wayside). One GoogleTest
+// test per vector, named LevelCrossingConformance.<file>_<vector id>, plus
+// LevelCrossingConformance.VectorSet, which fails if the vector set is missing, empty or
+// malformed.
+//
+//   railproof_conformance_lc --vectors DIR [--junit FILE] [gtest flags]
+//
+// Each file's header gives the configuration of its vectors: the variant (ONBOARD: the
+// on-board crossing function and one controller per crossing; GNSS: the centre scheduler and
+// the controllers), the crossings, the train, the permitted-speed profile and every
+// parameter (lc::onboard::ProtectionConfig, lc::wayside::ControllerConfig, lc::wayside::SchedulerConfig,
+// the departure), all in mm, mm/s, mm/s², ms (header "unit_scales": a model tick is 10 s, a
+// cell 100 m). Every vector starts from fresh units. Each step is one tick at t_ms; each unit
+// is fed the step's inputs for it (not the other units' outputs: every unit is checked on its
+// own) and must accept them:
+//   ONBOARD  the controllers' cycles (requests, withdrawals, barrier detection), then the
+//            on-board cycle (position, speed, dwell, the reports and acknowledgements received)
+//   GNSS     the centre's cycle (acknowledgements, reports, the position report), then the
+//            controllers' (start times, warning stops, clock, barrier detection)
+// Expected: every output and state field of the step (controller state, warning start,
+// report, acknowledgements, requesters, pending departure, clock, failure, lights, barrier
+// command, no alarm; on-board crossing states, ETA class, requests, withdrawals, stop limit;
+// centre messages, departure signal and its block, the per-crossing state). The model's
+// ETA class eta2 = 2 floor(E) + (E not whole), E in ticks, is compared with the C++ eta_ms.
+// On a mismatch the failure names the vector, the step, the unit, the field, expected and
+// actual. A report lists the controller's requesters; the on-board unit is cleared only by a
+// CLOSED report that lists it (design §3 item 3).
+// Last line: "railproof-conformance-lc: all N vectors passed" or
+// "railproof-conformance-lc: vectors mismatched: K of N" or "...: error: <reason>".
+#include <gtest/gtest.h>
+
+#include <array>
+#include <atomic>
+#include <cstddef>
+#include <cstdint>
+#include <cstdio>
+#include <filesystem>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <set>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "railproof/testing/jsonl_vectors.hpp"
+#include "railproof/br/patterns.hpp"
+#include "railproof/lc/onboard/crossing_protection.hpp"
+#include "railproof/lc/wayside/centre_scheduler.hpp"
+#include "railproof/lc/wayside/crossing_controller.hpp"
+#include "railproof/testing/runner_cli.hpp"
+
+namespace rcli = railproof::conformance;
+
+namespace {
+
+namespace fs = std::filesystem;
+namespace ob = railproof::lc::onboard;
+namespace ws = railproof::lc::wayside;
+namespace br = railproof::br;
+using json = nlohmann::json;
+
+constexpr const char* kModel = "models/lc.pml";
+constexpr const char* kUnits = "model tick = 10000 ms, model cell = 100000 mm (positions in half-cells)";
+constexpr std::int64_t kTickMs = 10000;
+
+// The configuration of one file (its header).
+struct FileConfig {
+  bool gnss = false;
+  std::vector<railproof::lc::CrossingData> crossings;
+  std::vector<railproof::core::RestrictionSegment> restrictions;
+  ob::ProtectionConfig protection;
+  std::vector<ws::ControllerConfig> controllers;
+  ws::SchedulerConfig scheduler;
+  ws::Departure departure;
+  std::int64_t started_at_ms = 0;
+};
+
+struct Vector {
+  std::string id;
+  std::string test_name;
+  std::string file;
+  std::size_t line = 0;
+  const FileConfig* config = nullptr;
+  json steps;
+};
+
+std::vector<Vector> g_vectors;
+std::set<std::string> g_files;
+std::map<std::string, FileConfig> g_configs;  // per file, from its header
+std::atomic<std::size_t> g_mismatched{0};
+std::atomic<std::size_t> g_replayed{0};
+
+bool IsInt(const json& o, const char* k) { return o.is_object() && o.contains(k) && o[k].is_number_integer(); }
+bool IsBool(const json& o, const char* k) { return o.is_object() && o.contains(k) && o[k].is_boolean(); }
+bool IsArr(const json& o, const char* k) { return o.is_object() && o.contains(k) && o[k].is_array(); }
+bool IsObj(const json& o, const char* k) { return o.is_object() && o.contains(k) && o[k].is_object(); }
+std::int64_t I(const json& o, const char* k) { return o.at(k).get<std::int64_t>(); }
+
+// The configuration of a file's header; "" or the reason it is unusable.
+std::string ConfigFromHeader(const json& h, FileConfig& cfg) {
+  const json& p = h["parameters"];
+  if (!p.is_object() || !IsObj(p, "train") || !IsArr(p, "crossings") || !IsArr(p, "restrictions") ||
+      !IsObj(p, "protection") || !IsObj(p, "controller")) {
+    return "header parameters need train, crossings, restrictions, protection, controller";
+  }
+  const std::string variant = h.value("variant", "");
+  if (variant != "ONBOARD" && variant != "GNSS") {
+    return "header variant must be ONBOARD or GNSS";
+  }
+  cfg.gnss = variant == "GNSS";
+  const json& t = p["train"];
+  const json& pr = p["protection"];
+  const json& c = p["controller"];
+  if (!IsInt(t, "id") || !IsInt(t, "length_mm") || !IsInt(t, "accel_max_mm_s2") || !IsInt(pr, "request_lead_ms") ||
+      !IsInt(pr, "confirmation_max_age_ms") || !IsInt(pr, "protection_offset_mm") || !IsInt(pr, "lookahead_mm") ||
+      !IsInt(c, "barrier_lowering_ms") || !IsInt(c, "barrier_timeout_ms") || !IsInt(c, "max_warning_ms") ||
+      !IsInt(c, "holdover_max_ms")) {
+    return "header parameters: a train, protection or controller field is missing or not an integer";
+  }
+  for (const json& x : p["crossings"]) {
+    if (!IsInt(x, "id") || !IsInt(x, "near_mm") || !IsInt(x, "far_mm") || !IsInt(x, "warning_time_ms")) {
+      return "header crossing needs integer id, near_mm, far_mm, warning_time_ms";
+    }
+    cfg.crossings.push_back(railproof::lc::CrossingData{static_cast<std::uint32_t>(I(x, "id")), I(x, "near_mm"), I(x, "far_mm"),
+                                             I(x, "warning_time_ms")});
+  }
+  for (const json& x : p["restrictions"]) {
+    if (!IsInt(x, "begin_mm") || !IsInt(x, "end_mm") || !IsInt(x, "limit_mm_s")) {
+      return "header restriction needs integer begin_mm, end_mm, limit_mm_s";
+    }
+    cfg.restrictions.push_back(railproof::core::RestrictionSegment{I(x, "begin_mm"), I(x, "end_mm"), I(x, "limit_mm_s")});
+  }
+  cfg.protection = ob::DefaultProtectionConfig(static_cast<std::uint32_t>(I(t, "id")), I(t, "length_mm"),
+                                               I(t, "accel_max_mm_s2"));
+  cfg.protection.request_lead_ms = I(pr, "request_lead_ms");
+  cfg.protection.confirmation_max_age_ms = I(pr, "confirmation_max_age_ms");
+  cfg.protection.protection_offset_mm = I(pr, "protection_offset_mm");
+  cfg.protection.lookahead_mm = I(pr, "lookahead_mm");
+  if (const auto r = ob::CrossingProtection::Create(cfg.protection); r.error != ob::ProtectionError::kNone) {
+    return std::string("header protection configuration rejected: ") + ToString(r.error);
+  }
+  for (const railproof::lc::CrossingData& x : cfg.crossings) {
+    ws::ControllerConfig cc = ws::DefaultControllerConfig(x.id);
+    cc.barrier_lowering_ms = I(c, "barrier_lowering_ms");
+    cc.barrier_timeout_ms = I(c, "barrier_timeout_ms");
+    cc.max_warning_ms = I(c, "max_warning_ms");
+    cc.holdover_max_ms = I(c, "holdover_max_ms");
+    if (const auto r = ws::CrossingController::Create(cc); r.error != ws::ControllerError::kNone) {
+      return std::string("header controller configuration rejected: ") + ToString(r.error);
+    }
+    cfg.controllers.push_back(cc);
+  }
+  if (cfg.gnss) {
+    if (!IsObj(p, "scheduler") || !IsInt(p["scheduler"], "clock_allowance_ms") || !IsObj(p, "departure")) {
+      return "GNSS header needs scheduler.clock_allowance_ms and departure";
+    }
+    const json& d = p["departure"];
+    if (!IsInt(d, "train_id") || !IsInt(d, "departure_id") || !IsInt(d, "departure_ms") || !IsInt(d, "front_mm") ||
+        !IsInt(d, "started_at_ms")) {
+      return "header departure needs integer train_id, departure_id, departure_ms, front_mm, started_at_ms";
+    }
+    cfg.scheduler = ws::DefaultSchedulerConfig(I(t, "accel_max_mm_s2"));
+    cfg.scheduler.clock_allowance_ms = I(p["scheduler"], "clock_allowance_ms");
+    if (const auto r = ws::CentreScheduler::Create(cfg.scheduler); r.error != ws::SchedulerError::kNone) {
+      return std::string("header scheduler configuration rejected: ") + ToString(r.error);
+    }
+    cfg.departure = ws::Departure{static_cast<std::uint32_t>(I(d, "train_id")),
+                                  static_cast<std::uint32_t>(I(d, "departure_id")), I(d, "departure_ms"),
+                                  I(d, "front_mm")};
+    cfg.started_at_ms = I(d, "started_at_ms");
+  }
+  return "";
+}
+
+// ---- step shape (the schema is checked when the vectors are written; this guards the harness
+// against a hand-edited or truncated file) ----------------------------------------------------
+bool IdsOk(const json& o, const char* k) {
+  if (!IsArr(o, k)) {
+    return false;
+  }
+  for (const json& x : o[k]) {
+    if (!x.is_number_integer()) {
+      return false;
+    }
+  }
+  return true;
+}
+
+bool ReportOk(const json& r) {
+  return r.is_object() && IsInt(r, "crossing_id") && r.contains("status") && r["status"].is_string() &&
+         IsInt(r, "warning_start_ms") && IsInt(r, "issued_ms") && IsBool(r, "clock_fault") && IdsOk(r, "requesters") &&
+         r["requesters"].size() <= railproof::messages::kMaxReportRequesters;
+}
+
+bool ControllerStepOk(const json& c, bool gnss) {
+  if (!c.is_object() || !IsInt(c, "crossing_id") || !IsObj(c, "in") || !IsObj(c, "out")) {
+    return false;
+  }
+  const json& in = c["in"];
+  const json& out = c["out"];
+  if (!IdsOk(in, "requests") || !IdsOk(in, "withdrawals") || !IsBool(in, "barrier_down") || !IsBool(in, "barrier_up")) {
+    return false;
+  }
+  if (!out.contains("state") || !out["state"].is_string() || !out.contains("warning_start_ms") ||
+      !(out["warning_start_ms"].is_null() || out["warning_start_ms"].is_number_integer()) || !IsObj(out, "report") ||
+      !ReportOk(out["report"]) || !IsBool(out, "lights_on") || !IsBool(out, "barriers_down_commanded") ||
+      !out.contains("failure") || !out["failure"].is_string()) {
+    return false;
+  }
+  if (!gnss) {
+    return IdsOk(out, "withdrawal_acks") && IdsOk(out, "requesters");
+  }
+  if (!IsArr(in, "start_times") || !IsArr(in, "warning_stops") || !in.contains("clock") || !in["clock"].is_string()) {
+    return false;
+  }
+  for (const json& m : in["start_times"]) {
+    if (!IsInt(m, "crossing_id") || !IsInt(m, "departure_id") || !IsInt(m, "start_ms")) {
+      return false;
+    }
+  }
+  for (const json& m : in["warning_stops"]) {
+    if (!IsInt(m, "crossing_id") || !IsInt(m, "departure_id")) {
+      return false;
+    }
+  }
+  return IsArr(out, "start_acks") && IsArr(out, "stop_acks") && IsObj(out, "pending") && out.contains("clock") &&
+         out["clock"].is_string();
+}
+
+bool StepWellFormed(const json& step, bool gnss) {
+  if (!step.is_object() || !IsInt(step, "t_ms") || !IsArr(step, "controllers") || step["controllers"].size() != 2 ||
+      !IsObj(step, "train")) {
+    return false;
+  }
+  for (const json& c : step["controllers"]) {
+    if (!ControllerStepOk(c, gnss)) {
+      return false;
+    }
+  }
+  if (!gnss) {
+    if (!IsObj(step, "onboard") || !IsObj(step["onboard"], "in") || !IsObj(step["onboard"], "out")) {
+      return false;
+    }
+    const json& tr = step["train"];
+    const json& in = step["onboard"]["in"];
+    const json& out = step["onboard"]["out"];
+    if (!IsInt(tr, "front_mm") || !IsInt(tr, "speed_mm_s") || !IsBool(tr, "dwell") || !IsInt(tr, "departure_ms") ||
+        !IsArr(in, "reports") || !IsArr(in, "acks") || !IsArr(out, "states") || !IsArr(out, "eta_half_ticks") ||
+        !IdsOk(out, "requests") || !IdsOk(out, "withdrawals") || !out.contains("stop_limit_mm")) {
+      return false;
+    }
+    for (const json& r : in["reports"]) {
+      if (!ReportOk(r)) {
+        return false;
+      }
+    }
+    for (const json& a : in["acks"]) {
+      if (!IsInt(a, "crossing_id") || !IsInt(a, "train_id")) {
+        return false;
+      }
+    }
+    return true;
+  }
+  if (!IsObj(step, "centre") || !IsObj(step["centre"], "in") || !IsObj(step["centre"], "out")) {
+    return false;
+  }
+  const json& in = step["centre"]["in"];
+  const json& out = step["centre"]["out"];
+  if (!IsArr(in, "start_acks") || !IsArr(in, "stop_acks") || !IsArr(in, "reports") || !in.contains("position") ||
+      !IsBool(out, "departure_cleared") || !out.contains("block") || !IsArr(out, "start_times") ||
+      !IsArr(out, "warning_stops") || !IsArr(out, "crossings")) {
+    return false;
+  }
+  for (const json& a : in["start_acks"]) {
+    if (!IsInt(a, "crossing_id") || !IsInt(a, "departure_id") || !IsInt(a, "start_ms") || !IsBool(a, "stored")) {
+      return false;
+    }
+  }
+  for (const json& r : in["reports"]) {
+    if (!ReportOk(r)) {
+      return false;
+    }
+  }
+  const json& pos = in["position"];
+  return pos.is_null() || (IsInt(pos, "train_id") && IsInt(pos, "time_ms") && IsInt(pos, "front_mm") &&
+                           IsInt(pos, "rear_mm") && IsInt(pos, "speed_mm_s"));
+}
+
+// Loads every lc*.jsonl of dir; an error names the file and line.
+bool Load(const fs::path& dir, std::string& error) {
+  std::size_t files = 0;
+  error = rcli::ReadVectorDirectory(
+      dir, "lc",
+      [](const std::string& file, const json& obj) -> std::string {
+        if (obj.value("kind", "") != "header" || obj.value("model", "") != kModel || !obj.contains("parameters")) {
+          return "first line is not a " + std::string(kModel) + " vector header";
+        }
+        if (obj.value("units", "") != kUnits) {
+          return "header units must be \"" + std::string(kUnits) + "\"";
+        }
+        FileConfig cfg;
+        if (std::string e = ConfigFromHeader(obj, cfg); !e.empty()) {
+          return e;
+        }
+        g_configs[file] = cfg;
+        g_files.insert(file);
+        return "";
+      },
+      [](const rcli::VectorLine& line) -> std::string {
+        const FileConfig& cfg = g_configs.at(line.file);
+        for (const json& step : (*line.obj)["steps"]) {
+          if (!StepWellFormed(step, cfg.gnss)) {
+            return "malformed step in vector " + line.id;
+          }
+        }
+        g_vectors.push_back(Vector{line.id, line.test_name, line.file, line.line, nullptr, (*line.obj)["steps"]});
+        return "";
+      },
+      files);
+  if (error.empty()) {
+    for (Vector& v : g_vectors) {
+      v.config = &g_configs.at(v.file);  // the map is complete: its addresses are stable now
+    }
+  }
+  return error.empty();
+}
+
+// ---- comparison helpers -------------------------------------------------------------------
+std::string Str(std::int64_t x) { return std::to_string(x); }
+std::string Bool(bool b) { return b ? "true" : "false"; }
+std::string OptInt(const json& j) { return j.is_null() ? "null" : Str(j.get<std::int64_t>()); }
+std::string OptInt(const std::optional<std::int64_t>& x) { return x.has_value() ? Str(*x) : "null"; }
+std::string Ids(const json& a) {
+  std::string s = "[";
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    s += (i ? "," : "") + Str(a[i].get<std::int64_t>());
+  }
+  return s + "]";
+}
+template <typename T>
+std::string Ids(std::span<const T> a) {
+  std::string s = "[";
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    s += (i ? "," : "") + Str(static_cast<std::int64_t>(a[i]));
+  }
+  return s + "]";
+}
+
+class Checker {
+ public:
+  Checker(std::vector<std::string>& problems, std::string where) : problems_(problems), where_(std::move(where)) {}
+  void Expect(const std::string& field, const std::string& expected, const std::string& actual) {
+    if (expected != actual) {
+      problems_.push_back(where_ + field + " expected " + expected + ", got " + actual);
+    }
+  }
+  void Fail(const std::string& what) { problems_.push_back(where_ + what); }
+
+ private:
+  std::vector<std::string>& problems_;
+  std::string where_;
+};
+
+ob::CrossingStatus StatusOf(const std::string& s) {
+  if (s == "WARNING") {
+    return ob::CrossingStatus::kWarning;
+  }
+  if (s == "CLOSED") {
+    return ob::CrossingStatus::kClosed;
+  }
+  if (s == "FAILED") {
+    return ob::CrossingStatus::kFailed;
+  }
+  return ob::CrossingStatus::kOpen;
+}
+
+ob::CrossingReport ReportOf(const json& r) {
+  ob::CrossingReport rep{static_cast<std::uint32_t>(I(r, "crossing_id")), StatusOf(r.at("status").get<std::string>()),
+                         I(r, "warning_start_ms"), I(r, "issued_ms"), r.at("clock_fault").get<bool>()};
+  const json& ids = r.at("requesters");  // at most kMaxReportRequesters (ReportOk)
+  for (const json& id : ids) {
+    rep.requesters[rep.requester_count++] = static_cast<std::uint32_t>(id.get<std::int64_t>());
+  }
+  return rep;
+}
+
+ws::ClockInput ClockOf(const std::string& s) {
+  if (s == "NO_GNSS") {
+    return ws::ClockInput::kNoGnss;
+  }
+  if (s == "FAULT") {
+    return ws::ClockInput::kFault;
+  }
+  return ws::ClockInput::kGnss;
+}
+
+std::string ReportString(const ob::CrossingReport& r) {
+  return "{" + Str(r.crossing_id) + "," + ToString(r.status) + ",ws=" + Str(r.warning_start_ms) +
+         ",issued=" + Str(r.issued_ms) + ",cf=" + Bool(r.clock_fault) +
+         ",requesters=" + Ids(std::span<const std::uint32_t>(r.requesters.data(), r.requester_count)) + "}";
+}
+std::string ReportString(const json& r) { return ReportString(ReportOf(r)); }
+
+// One controller cycle and the comparison of its outputs (both variants).
+void StepController(ws::CrossingController& ctl, std::int64_t now, const json& c, bool gnss, Checker& chk) {
+  const json& in = c.at("in");
+  const json& out = c.at("out");
+  std::vector<std::uint32_t> requests;
+  std::vector<std::uint32_t> withdrawals;
+  for (const json& x : in.at("requests")) {
+    requests.push_back(x.get<std::uint32_t>());
+  }
+  for (const json& x : in.at("withdrawals")) {
+    withdrawals.push_back(x.get<std::uint32_t>());
+  }
+  std::vector<ws::StartTimeMessage> starts;
+  std::vector<ws::WarningStopMessage> stops;
+  ws::ControllerInput ci;
+  ci.now_ms = now;
+  ci.requests = requests;
+  ci.withdrawals = withdrawals;
+  ci.barrier_down = in.at("barrier_down").get<bool>();
+  ci.barrier_up = in.at("barrier_up").get<bool>();
+  if (gnss) {
+    for (const json& m : in.at("start_times")) {
+      starts.push_back(ws::StartTimeMessage{static_cast<std::uint32_t>(I(m, "crossing_id")),
+                                            static_cast<std::uint32_t>(I(m, "departure_id")), I(m, "start_ms")});
+    }
+    for (const json& m : in.at("warning_stops")) {
+      stops.push_back(ws::WarningStopMessage{static_cast<std::uint32_t>(I(m, "crossing_id")),
+                                             static_cast<std::uint32_t>(I(m, "departure_id"))});
+    }
+    ci.start_times = starts;
+    ci.warning_stops = stops;
+    ci.clock = ClockOf(in.at("clock").get<std::string>());
+  }
+  if (const ws::ControllerError e = ctl.Cycle(ci); e != ws::ControllerError::kNone) {
+    chk.Fail(std::string("Cycle rejected the inputs: ") + ToString(e) + " [inputs " + in.dump() + "]");
+    return;
+  }
+  const ws::ControllerStatus& s = ctl.Status();
+  const ws::ControllerOutput& o = ctl.Output();
+  chk.Expect("state", out.at("state").get<std::string>(), ToString(s.state));
+  if (!out.at("warning_start_ms").is_null()) {
+    chk.Expect("warning_start_ms", OptInt(out.at("warning_start_ms")), Str(s.warning_start_ms));
+  }
+  chk.Expect("report", ReportString(out.at("report")), ReportString(o.report));
+  chk.Expect("lights_on", Bool(out.at("lights_on").get<bool>()), Bool(o.lights_on));
+  chk.Expect("barriers_down_commanded", Bool(out.at("barriers_down_commanded").get<bool>()),
+             Bool(o.barriers_down_commanded));
+  chk.Expect("failure", out.at("failure").get<std::string>(), ToString(s.failure));
+  chk.Expect("alarm", "false", Bool(o.alarm));
+  if (!gnss) {
+    chk.Expect("withdrawal_acks", Ids(out.at("withdrawal_acks")), Ids(o.WithdrawalAcks()));
+    chk.Expect("requesters", Ids(out.at("requesters")), Ids(s.Requesters()));
+    return;
+  }
+  std::string exp_acks;
+  for (const json& a : out.at("start_acks")) {
+    exp_acks += "{" + Str(I(a, "crossing_id")) + "," + Str(I(a, "departure_id")) + "," + Str(I(a, "start_ms")) + "," +
+                Bool(a.at("stored").get<bool>()) + "}";
+  }
+  std::string act_acks;
+  for (const ws::StartTimeAck& a : o.StartAcks()) {
+    act_acks += "{" + Str(a.crossing_id) + "," + Str(a.departure_id) + "," + Str(a.start_ms) + "," + Bool(a.stored) + "}";
+  }
+  chk.Expect("start_acks", "[" + exp_acks + "]", "[" + act_acks + "]");
+  std::string exp_stops;
+  for (const json& a : out.at("stop_acks")) {
+    exp_stops += "{" + Str(I(a, "crossing_id")) + "," + Str(I(a, "departure_id")) + "}";
+  }
+  std::string act_stops;
+  for (const ws::WarningStopAck& a : o.StopAcks()) {
+    act_stops += "{" + Str(a.crossing_id) + "," + Str(a.departure_id) + "}";
+  }
+  chk.Expect("stop_acks", "[" + exp_stops + "]", "[" + act_stops + "]");
+  const json& p = out.at("pending");
+  chk.Expect("pending.present", Bool(p.at("present").get<bool>()), Bool(s.pending.present));
+  if (p.at("present").get<bool>() && s.pending.present) {
+    chk.Expect("pending.departure_id", OptInt(p.at("departure_id")), Str(s.pending.departure_id));
+    chk.Expect("pending.start_ms", OptInt(p.at("start_ms")), Str(s.pending.start_ms));
+    chk.Expect("pending.active", Bool(p.at("active").get<bool>()), Bool(s.pending.active));
+  }
+  chk.Expect("clock", out.at("clock").get<std::string>(), ToString(s.clock));
+}
+
+// The model's ETA class of a C++ ETA (ms): 2 floor(E) + (E not whole), E in ticks; -1 if none.
+std::string EtaClass(std::int64_t eta_ms) {
+  if (eta_ms < 0) {
+    return "null";
+  }
+  return Str(2 * (eta_ms / kTickMs) + (eta_ms % kTickMs != 0 ? 1 : 0));
+}
+
+void ReplayOnboard(const Vector& v, std::vector<std::string>& problems) {
+  const FileConfig& cfg = *v.config;
+  auto created = ob::CrossingProtection::Create(cfg.protection);
+  if (created.error != ob::ProtectionError::kNone) {
+    problems.push_back(std::string("CrossingProtection::Create: ") + ToString(created.error));
+    return;
+  }
+  ob::CrossingProtection& prot = *created.protection;
+  if (const ob::ProtectionError e = prot.LoadCrossings(cfg.crossings); e != ob::ProtectionError::kNone) {
+    problems.push_back(std::string("LoadCrossings: ") + ToString(e));
+    return;
+  }
+  std::vector<ws::CrossingController> ctls;
+  for (const ws::ControllerConfig& cc : cfg.controllers) {
+    ctls.push_back(*ws::CrossingController::Create(cc).controller);
+  }
+  for (std::size_t k = 0; k < v.steps.size() && problems.empty(); ++k) {
+    const json& step = v.steps[k];
+    const std::int64_t now = I(step, "t_ms");
+    const std::string at = "step " + std::to_string(k) + " (t=" + Str(now) + " ms): ";
+    for (std::size_t c = 0; c < ctls.size(); ++c) {
+      Checker chk(problems, at + "controller " + Str(cfg.crossings[c].id) + " ");
+      StepController(ctls[c], now, step.at("controllers")[c], false, chk);
+    }
+    const json& tr = step.at("train");
+    const json& in = step.at("onboard").at("in");
+    const json& out = step.at("onboard").at("out");
+    std::vector<ob::CrossingReport> reports;
+    std::vector<ob::WithdrawalAck> acks;
+    for (const json& r : in.at("reports")) {
+      reports.push_back(ReportOf(r));
+    }
+    for (const json& a : in.at("acks")) {
+      acks.push_back(ob::WithdrawalAck{static_cast<std::uint32_t>(I(a, "crossing_id")),
+                                       static_cast<std::uint32_t>(I(a, "train_id"))});
+    }
+    ob::ProtectionInput pi;
+    pi.now_ms = now;
+    pi.front_mm = I(tr, "front_mm");
+    pi.speed_mm_s = I(tr, "speed_mm_s");
+    pi.dwell = tr.at("dwell").get<bool>();
+    pi.departure_ms = I(tr, "departure_ms");
+    pi.restrictions = cfg.restrictions;
+    pi.reports = reports;
+    pi.acks = acks;
+    Checker chk(problems, at + "on-board ");
+    if (const ob::ProtectionError e = prot.Cycle(pi); e != ob::ProtectionError::kNone) {
+      chk.Fail(std::string("Cycle rejected the inputs: ") + ToString(e) + " [inputs " + tr.dump() + "]");
+      break;
+    }
+    const auto entries = prot.Entries();
+    for (std::size_t c = 0; c < entries.size() && c < out.at("states").size(); ++c) {
+      const std::string name = "crossing " + Str(entries[c].data.id) + " ";
+      chk.Expect(name + "state", out.at("states")[c].get<std::string>(), ToString(entries[c].state));
+      chk.Expect(name + "eta class", OptInt(out.at("eta_half_ticks")[c]), EtaClass(entries[c].eta_ms));
+    }
+    const ob::ProtectionOutput& o = prot.Output();
+    chk.Expect("requests", Ids(out.at("requests")), Ids(o.Requests()));
+    chk.Expect("withdrawals", Ids(out.at("withdrawals")), Ids(o.Withdrawals()));
+    chk.Expect("stop_limit_mm", OptInt(out.at("stop_limit_mm")), OptInt(o.stop_limit_mm));
+  }
+}
+
+void ReplayGnss(const Vector& v, std::vector<std::string>& problems) {
+  const FileConfig& cfg = *v.config;
+  auto created = ws::CentreScheduler::Create(cfg.scheduler);
+  if (created.error != ws::SchedulerError::kNone) {
+    problems.push_back(std::string("CentreScheduler::Create: ") + ToString(created.error));
+    return;
+  }
+  ws::CentreScheduler& centre = *created.scheduler;
+  if (const ws::SchedulerError e = centre.StartDeparture(cfg.departure, cfg.crossings, cfg.restrictions, cfg.started_at_ms);
+      e != ws::SchedulerError::kNone) {
+    problems.push_back(std::string("StartDeparture: ") + ToString(e));
+    return;
+  }
+  std::vector<ws::CrossingController> ctls;
+  for (const ws::ControllerConfig& cc : cfg.controllers) {
+    ctls.push_back(*ws::CrossingController::Create(cc).controller);
+  }
+  for (std::size_t k = 0; k < v.steps.size() && problems.empty(); ++k) {
+    const json& step = v.steps[k];
+    const std::int64_t now = I(step, "t_ms");
+    const std::string at = "step " + std::to_string(k) + " (t=" + Str(now) + " ms): ";
+    const json& in = step.at("centre").at("in");
+    const json& out = step.at("centre").at("out");
+    std::vector<ws::StartTimeAck> sacks;
+    std::vector<ws::WarningStopAck> stacks;
+    std::vector<ob::CrossingReport> reports;
+    for (const json& a : in.at("start_acks")) {
+      sacks.push_back(ws::StartTimeAck{static_cast<std::uint32_t>(I(a, "crossing_id")),
+                                       static_cast<std::uint32_t>(I(a, "departure_id")), I(a, "start_ms"),
+                                       a.at("stored").get<bool>()});
+    }
+    for (const json& a : in.at("stop_acks")) {
+      stacks.push_back(ws::WarningStopAck{static_cast<std::uint32_t>(I(a, "crossing_id")),
+                                          static_cast<std::uint32_t>(I(a, "departure_id"))});
+    }
+    for (const json& r : in.at("reports")) {
+      reports.push_back(ReportOf(r));
+    }
+    ws::SchedulerInput si;
+    si.now_ms = now;
+    si.start_acks = sacks;
+    si.stop_acks = stacks;
+    si.reports = reports;
+    si.restrictions = cfg.restrictions;
+    if (const json& p = in.at("position"); !p.is_null()) {
+      si.position = ws::CentrePositionReport{static_cast<std::uint32_t>(I(p, "train_id")), I(p, "time_ms"), I(p, "front_mm"),
+                                       I(p, "rear_mm"), I(p, "speed_mm_s")};
+    }
+    {
+      Checker chk(problems, at + "centre ");
+      if (const ws::SchedulerError e = centre.Cycle(si); e != ws::SchedulerError::kNone) {
+        chk.Fail(std::string("Cycle rejected the inputs: ") + ToString(e) + " [inputs " + in.dump() + "]");
+        break;
+      }
+      const ws::SchedulerOutput& o = centre.Output();
+      chk.Expect("departure_cleared", Bool(out.at("departure_cleared").get<bool>()), Bool(o.departure_cleared));
+      chk.Expect("block", out.at("block").get<std::string>(), ToString(o.block));
+      std::string exp;
+      for (const json& m : out.at("start_times")) {
+        exp += "{" + Str(I(m, "crossing_id")) + "," + Str(I(m, "departure_id")) + "," + Str(I(m, "start_ms")) + "}";
+      }
+      std::string act;
+      for (const ws::StartTimeMessage& m : o.StartTimes()) {
+        act += "{" + Str(m.crossing_id) + "," + Str(m.departure_id) + "," + Str(m.start_ms) + "}";
+      }
+      chk.Expect("start_times", "[" + exp + "]", "[" + act + "]");
+      exp.clear();
+      act.clear();
+      for (const json& m : out.at("warning_stops")) {
+        exp += "{" + Str(I(m, "crossing_id")) + "," + Str(I(m, "departure_id")) + "}";
+      }
+      for (const ws::WarningStopMessage& m : o.WarningStops()) {
+        act += "{" + Str(m.crossing_id) + "," + Str(m.departure_id) + "}";
+      }
+      chk.Expect("warning_stops", "[" + exp + "]", "[" + act + "]");
+      for (const json& e : out.at("crossings")) {
+        const ws::ScheduledCrossing* sc = centre.Find(static_cast<std::uint32_t>(I(e, "crossing_id")));
+        const std::string name = "crossing " + Str(I(e, "crossing_id")) + " ";
+        if (sc == nullptr) {
+          chk.Fail(name + "not held by the scheduler");
+          continue;
+        }
+        chk.Expect(name + "start_ms", Str(I(e, "start_ms")), Str(sc->start_ms));
+        chk.Expect(name + "start_pending", Bool(e.at("start_pending").get<bool>()), Bool(sc->start_pending));
+        chk.Expect(name + "acked", Bool(e.at("acked").get<bool>()), Bool(sc->acked));
+        chk.Expect(name + "passed", Bool(e.at("passed").get<bool>()), Bool(sc->passed));
+        chk.Expect(name + "stop_pending", Bool(e.at("stop_pending").get<bool>()), Bool(sc->stop_pending));
+        chk.Expect(name + "stop_acked", Bool(e.at("stop_acked").get<bool>()), Bool(sc->stop_acked));
+        chk.Expect(name + "clock_fault", Bool(e.at("clock_fault").get<bool>()), Bool(sc->clock_fault));
+      }
+    }
+    for (std::size_t c = 0; c < ctls.size() && problems.empty(); ++c) {
+      Checker chk(problems, at + "controller " + Str(cfg.crossings[c].id) + " ");
+      StepController(ctls[c], now, step.at("controllers")[c], true, chk);
+    }
+  }
+}
+
+class VectorTest : public testing::Test {
+ public:
+  explicit VectorTest(std::size_t index) : index_(index) {}
+  void TestBody() override {
+    const Vector& v = g_vectors[index_];
+    g_replayed.fetch_add(1);
+    RecordProperty("vector_id", v.id);
+    std::vector<std::string> problems;
+    if (v.config->gnss) {
+      ReplayGnss(v, problems);
+    } else {
+      ReplayOnboard(v, problems);
+    }
+    if (!problems.empty()) {
+      g_mismatched.fetch_add(1);
+    }
+    for (const std::string& p : problems) {
+      ADD_FAILURE_AT(v.file.c_str(), static_cast<int>(v.line)) << "vector " << v.id << ": " << p;
+    }
+  }
+
+ private:
+  std::size_t index_;
+};
+
+void Usage(std::FILE* f) {
+  std::fprintf(f,
+               "usage: railproof_conformance_lc --vectors DIR [--junit FILE] [gtest flags]\n"
+               "Replays every lc*.jsonl vector of DIR against the C++ level-crossing units\n"
+               "(lc::onboard::CrossingProtection, lc::wayside::CrossingController, lc::wayside::CentreScheduler),\n"
+               "configured by each file's header. Exit 0 only if every vector matches.\n");
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const rcli::RunnerArgs args = rcli::ParseArgsAndInitGoogleTest("railproof-conformance-lc", argc, argv, Usage);
+  if (args.exit_code >= 0) {
+    return args.exit_code;
+  }
+  std::string error;
+  const bool ok = Load(args.vectors_dir, error);
+  return rcli::RunVectorTests(
+      "railproof-conformance-lc", "LevelCrossingConformance", args, ok, error, ok ? g_vectors.size() : 0, g_files.size(),
+      [](std::size_t i) {
+        const Vector& v = g_vectors[i];
+        return rcli::VectorSite{v.test_name, v.file, static_cast<int>(v.line)};
+      },
+      [](std::size_t i) -> testing::Test* { return new VectorTest(i); }, g_mismatched, g_replayed);
+}

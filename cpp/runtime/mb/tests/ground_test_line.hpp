@@ -1,0 +1,121 @@
+// Test line and helpers shared by the wayside unit tests (not a test file itself).
+//
+// The default test line: 2 km, 40 virtual blocks of 50 m, distinct margins per obstruction
+// kind (so a test can tell which margin was applied), times from the parameters
+// (tracking timeout 3000 ms, validity 3000 ms, cycle 500 ms, set-back 3000 mm).
+#pragma once
+
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <utility>
+#include <vector>
+
+#include "railproof/mb/wayside/ground.hpp"
+
+namespace railproof::mb::wayside::test {
+
+inline constexpr std::int64_t kLen = 2'000'000;
+inline constexpr std::int64_t kBlock = 50'000;
+inline constexpr std::int64_t kTrainLen = 100'000;
+inline constexpr Margins kMargins{20'000, 21'000, 30'000, 22'000, 23'000, 50'000, 40'000, 10'000};
+inline constexpr std::int64_t kEot = kLen - 10'000;  // END_OF_TRACK limit
+
+struct TestLine {
+  std::vector<std::int64_t> blocks;
+  std::vector<Section> fixed;
+  std::vector<Section> setback;
+  std::vector<Section> no_stop;
+  std::vector<PointsConfig> points;
+  std::vector<RouteConfig> routes;
+  std::vector<HandoverConfig> handovers;
+  std::optional<std::int64_t> boundary;
+  LineConfig base;
+
+  TestLine() : base(DefaultLineParameters()) {
+    base.length_mm = kLen;
+    base.margins = kMargins;
+    for (std::int64_t x = 0; x <= kLen; x += kBlock) {
+      blocks.push_back(x);
+    }
+  }
+
+  // Points P10 on block 20 [1.0 km, 1.05 km); automatic main route 1 (normal) and
+  // requested siding route 2 (reverse), both [1.0 km, 1.1 km).
+  TestLine& WithJunction() {
+    points.push_back(PointsConfig{10, Section{1'000'000, 1'050'000}});
+    routes.push_back(RouteConfig{1, 1'000'000, 1'100'000, 0, false, true});
+    routes.push_back(RouteConfig{2, 1'000'000, 1'100'000, 0, true, false});
+    return *this;
+  }
+
+  [[nodiscard]] LineConfig Config() const {
+    LineConfig c = base;
+    c.blocks_mm = blocks;
+    c.fixed_blocks = fixed;
+    c.setback_sections = setback;
+    c.no_stop_sections = no_stop;
+    c.points = points;
+    c.routes = routes;
+    c.handovers = handovers;
+    c.system_boundary_mm = boundary;
+    return c;
+  }
+};
+
+inline Capacity SmallCapacity() {
+  Capacity c = DefaultCapacity();
+  c.trains = 16;
+  c.blocks = 64;
+  c.routes = 8;
+  c.points = 8;
+  c.sections = 8;
+  c.handovers = 8;
+  c.possessions = 4;
+  c.restrictions = 12;
+  c.unequipped = 4;
+  return c;
+}
+
+inline std::unique_ptr<Ground> MakeGround(const TestLine& line, const Capacity& cap = SmallCapacity()) {
+  auto created = Ground::Create(line.Config(), cap);
+  EXPECT_EQ(created.error, ConfigError::kNone) << ToString(created.error) << " entry " << created.entry;
+  return std::move(created.ground);
+}
+
+inline RegisterStatus Register(Ground& g, std::uint32_t id, std::int64_t front, std::int64_t corr = 0,
+                               InitialPosition initial = InitialPosition::kEntryBalise,
+                               std::int64_t length = kTrainLen) {
+  return g.RegisterTrain(TrainRegistration{id, length, front, corr, initial});
+}
+
+inline PositionReport MakeReport(const Ground& g, std::uint32_t id, std::int64_t front, std::int64_t corr = 0,
+                                 std::int64_t length = kTrainLen) {
+  const auto pos = g.LocateFront(front);
+  EXPECT_TRUE(pos.has_value()) << "front " << front;
+  const BlockPosition p = pos.value_or(BlockPosition{0, 0});
+  return PositionReport{id, p.block, p.offset_mm, length, corr, 0, 0, Direction::kNominal};
+}
+
+inline ReportStatus Report(Ground& g, std::uint32_t id, std::int64_t front, std::int64_t corr = 0) {
+  return g.OnReport(MakeReport(g, id, front, corr));
+}
+
+inline std::optional<std::int64_t> LimitOf(const Ground& g, std::uint32_t id) {
+  const auto t = g.Train(id);
+  return t.has_value() ? t->limit_mm : std::nullopt;
+}
+
+inline Obstruction KindOf(const Ground& g, std::uint32_t id) {
+  const auto t = g.Train(id);
+  return t.has_value() ? t->kind : Obstruction::kNone;
+}
+
+inline bool AbnormalOf(const Ground& g, std::uint32_t id) {
+  const auto t = g.Train(id);
+  return t.has_value() && t->abnormal;
+}
+
+}  // namespace railproof::mb::wayside::test

@@ -1,0 +1,180 @@
+// One odometry cycle (spec/design/ra.md; budget <= 50 us per 100 ms cycle on one
+// core): Odometry::Step in TG odometry, in a compensating cycle with both parallel start
+// points active, and on the detection cycle with the deepest catch-up (start point at the
+// oldest allowed point d - 75, the second at d - 100: 175 candidate cycles integrated from
+// the history). Synthetic 12 m/s stream, level line, 90-tooth TG, 10 IMU samples a cycle.
+// The compensating and detection cycles are timed manually around Step (the state is
+// restored from a copy outside the timed region).
+#include <benchmark/benchmark.h>
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <cstdlib>
+#include <memory>
+#include <vector>
+
+#include "railproof/ra/odometry.hpp"
+
+namespace {
+
+using railproof::ra::CycleInput;
+using railproof::ra::Method;
+using railproof::ra::Mode;
+using railproof::ra::Odometry;
+using railproof::ra::OdometryConfig;
+using railproof::ra::OdometrySection;
+
+constexpr double kPulseM = 3.14159265358979323846 * 0.86 / 90.0;
+
+// Train at constant speed; from cycle `slip_from` the wheel slips with a slip speed rising
+// 0.3 m/s per cycle to 3 m/s and staying there (no re-adhesion). With `noisy_jerk` the IMU
+// a_x alternates +1, +1, -1, -1 m/s^2 so the jerk conditions fail in every cycle (the
+// start-point search falls back to the oldest point).
+std::vector<CycleInput> MakeStream(int cycles, int slip_from, bool noisy_jerk) {
+  std::vector<CycleInput> out;
+  out.reserve(static_cast<std::size_t>(cycles));
+  const double v = 12.0;
+  double xw = 0, slip = 0;  // wheel distance and slip speed
+  std::int64_t pulses = 0, edge = 0, t_ms = 1'000;
+  for (int k = 0; k < cycles; ++k) {
+    t_ms += 100;
+    const double slip_end = k < slip_from ? 0.0 : std::min(3.0, 0.3 * (k - slip_from + 1));
+    for (int ms = 1; ms <= 100; ++ms) {
+      const double s1 = slip + (slip_end - slip) * ms / 100.0;
+      const double xw0 = xw;
+      xw += (v + s1) * 0.001;
+      while (std::floor(xw / kPulseM) > static_cast<double>(pulses)) {
+        ++pulses;
+        const double frac = (static_cast<double>(pulses) * kPulseM - xw0) / (xw - xw0);
+        edge = std::max<std::int64_t>(edge + 1, (t_ms - 100) * 1000 + (ms - 1) * 1000 + std::llround(frac * 1000.0));
+      }
+    }
+    slip = slip_end;
+    CycleInput in;
+    in.time_ms = t_ms;
+    in.tg.time_us = t_ms * 1000;
+    in.tg.pulses = pulses;
+    in.tg.last_edge_us = edge;
+    for (int j = 0; j < 10; ++j) {
+      auto& s = in.imu[static_cast<std::size_t>(j)];
+      s.time_us = t_ms * 1000 - (9 - j) * 10'000;
+      s.ax = noisy_jerk ? ((k % 4 < 2) ? 1.0 : -1.0) : 0.01 * std::sin(0.3 * j + k);
+      s.ay = 0.02;
+      s.az = 9.807;
+      s.wx = 0.001;
+      s.wy = 0.0005;
+      s.wz = 0.002;
+    }
+    out.push_back(in);
+  }
+  return out;
+}
+
+const std::vector<OdometrySection>& Sections() {
+  static const std::vector<OdometrySection> s = {{0, 100'000'000, 0, 20'000, 0}};
+  return s;
+}
+
+std::unique_ptr<Odometry> Make() {
+  OdometryConfig cfg;
+  cfg.method = Method::kImu;
+  cfg.train_length_mm = 60'000;
+  cfg.sections = Sections().data();
+  cfg.section_count = static_cast<int>(Sections().size());
+  cfg.initial_front_mm = 1'000'000;
+  auto od = std::make_unique<Odometry>();
+  if (Odometry::Create(cfg, *od) != railproof::ra::ConfigError::kNone) std::abort();
+  return od;
+}
+
+// TG odometry: every cycle of a 4096-cycle stream without slip (re-created at its end).
+void BM_OdometryStepTg(benchmark::State& state) {
+  const auto stream = MakeStream(4'096, 1'000'000, false);
+  auto od = Make();
+  std::size_t i = 0;
+  for (auto _ : state) {
+    if (i == stream.size()) {
+      state.PauseTiming();
+      od = Make();
+      i = 0;
+      state.ResumeTiming();
+    }
+    benchmark::DoNotOptimize(od->Step(stream[i]));
+    ++i;
+  }
+  if (od->output().mode != Mode::kTg) state.SkipWithError("not in TG odometry");
+  state.SetLabel("TG mode, 12 m/s");
+}
+BENCHMARK(BM_OdometryStepTg);
+
+// Compensating with both start points active: the cycles after the detection until the
+// older candidate times out, replayed from a copy of the state after the detection.
+void BM_OdometryStepCompensatingTwoCandidates(benchmark::State& state) {
+  const auto stream = MakeStream(400, 200, false);
+  auto od = Make();
+  std::size_t d = 0;
+  for (std::size_t k = 0; k < stream.size(); ++k) {
+    if (od->Step(stream[k]).detected) {
+      d = k;
+      break;
+    }
+  }
+  if (d == 0) {
+    state.SkipWithError("no detection");
+    return;
+  }
+  auto snapshot = std::make_unique<Odometry>(*od);
+  std::size_t i = d + 1;
+  for (auto _ : state) {
+    const auto& st = od->machine().state();
+    if (i == stream.size() || !(st.candidates[0].active && st.candidates[1].active)) {
+      *od = *snapshot;
+      i = d + 1;
+    }
+    const auto t0 = std::chrono::steady_clock::now();
+    benchmark::DoNotOptimize(od->Step(stream[i]));
+    const auto t1 = std::chrono::steady_clock::now();
+    state.SetIterationTime(std::chrono::duration<double>(t1 - t0).count());
+    ++i;
+  }
+  state.SetLabel("two candidates active");
+}
+BENCHMARK(BM_OdometryStepCompensatingTwoCandidates)->UseManualTime();
+
+// The detection cycle with the deepest catch-up (start point d - 75, second d - 100).
+void BM_OdometryStepDetectionWorstCase(benchmark::State& state) {
+  const auto stream = MakeStream(300, 200, true);
+  auto od = Make();
+  std::size_t d = 0;
+  for (std::size_t k = 0; k < stream.size(); ++k) {
+    Odometry before(*od);
+    if (od->Step(stream[k]).detected) {
+      d = k;
+      *od = before;
+      break;
+    }
+  }
+  if (d == 0) {
+    state.SkipWithError("no detection");
+    return;
+  }
+  auto snapshot = std::make_unique<Odometry>(*od);
+  std::int32_t age = 0;
+  for (auto _ : state) {
+    *od = *snapshot;
+    const auto t0 = std::chrono::steady_clock::now();
+    const auto& o = od->Step(stream[d]);
+    benchmark::DoNotOptimize(o);
+    const auto t1 = std::chrono::steady_clock::now();
+    state.SetIterationTime(std::chrono::duration<double>(t1 - t0).count());
+    age = o.start_age_cycles;
+  }
+  if (age != 75) state.SkipWithError("not the deepest catch-up");
+  state.SetLabel("catch-up 75 + 100 cycles");
+}
+BENCHMARK(BM_OdometryStepDetectionWorstCase)->UseManualTime();
+
+}  // namespace

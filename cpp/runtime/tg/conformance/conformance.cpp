@@ -1,0 +1,277 @@
+// railproof_conformance: replays the vectors generated from models/tg.pml against the
+// C++ endpoint (spec/design/tg.md §7). One GoogleTest test per vector, named
+// TelegramConformance.<vector id with non-alphanumerics as '_'>, plus
+// TelegramConformance.VectorSet, which fails if the vector set is missing, empty or
+// malformed (a conformance run over no vectors is a failure).
+//
+//   railproof_conformance --vectors DIR [--junit FILE] [gtest flags]
+//
+// On a mismatch the failure names the vector id, the step index, the field, the expected
+// and the actual value. The last line is a summary:
+//   "railproof-conformance-tg: all N vectors passed"
+//   "railproof-conformance-tg: vectors mismatched: K of N"
+//   "railproof-conformance-tg: error: <reason>"            (no usable vector set)
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
+#include <sstream>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "railproof/testing/runner_cli.hpp"
+#include "railproof/tg/aead.hpp"
+#include "railproof/tg/endpoint.hpp"
+#include "railproof/tg/frame.hpp"
+#include "railproof/tg/telegram.hpp"
+#include "vector_reader.hpp"
+
+namespace rcli = railproof::conformance;
+
+namespace {
+
+namespace rr = railproof::tg;
+namespace rc = railproof::conformance;
+
+// Keys of the conformance configuration (public test values).
+constexpr std::array<std::uint8_t, rr::kKeyBytes> kLinkKeyBytes = {
+    0x63, 0x6f, 0x6e, 0x66, 0x6f, 0x72, 0x6d, 0x61, 0x6e, 0x63, 0x65, 0x2d, 0x6c, 0x69, 0x6e, 0x6b,
+    0x2d, 0x6b, 0x65, 0x79, 0x01, 0x02, 0x03, 0x04, 0x05, 0x06, 0x07, 0x08, 0x09, 0x0a, 0x0b, 0x0c};
+constexpr std::array<std::uint8_t, rr::kKeyBytes> kAttackerKeyBytes = {
+    0x61, 0x74, 0x74, 0x61, 0x63, 0x6b, 0x65, 0x72, 0x2d, 0x6b, 0x65, 0x79, 0x2d, 0x6e, 0x6f, 0x74,
+    0x2d, 0x74, 0x68, 0x65, 0x2d, 0x6c, 0x69, 0x6e, 0x6b, 0x2d, 0x6b, 0x65, 0x79, 0x21, 0x21, 0x21};
+
+// design §7: integrity "corrupt" overwrites 9 symbols of RS block 0 (radius t = 8) with
+// different values.
+constexpr std::size_t kCorruptSymbols = 9;
+constexpr std::size_t kCorruptStride = 7;
+static_assert(kCorruptSymbols * kCorruptStride <= rr::kBlockBytes);
+
+rc::VectorSet g_set;
+std::atomic<std::size_t> g_mismatched{0};
+std::atomic<std::size_t> g_replayed{0};
+
+struct Mismatch {
+  std::size_t step;
+  const char* ev;
+  std::string field;
+  std::string expected;
+  std::string actual;
+};
+
+std::string Str(std::uint64_t v) { return std::to_string(v); }
+std::string Str(bool v) { return v ? "true" : "false"; }
+std::string Str(const std::optional<std::uint32_t>& v) { return v ? std::to_string(*v) : "null"; }
+std::string Tracking(bool abnormal) { return abnormal ? "ABNORMAL" : "TRACKED"; }
+
+class StepChecker {
+ public:
+  StepChecker(std::size_t step, const char* ev, std::vector<Mismatch>& out) : step_(step), ev_(ev), out_(out) {}
+  template <typename T>
+  void Field(const char* name, const T& expected, const T& actual) {
+    if (!(expected == actual)) {
+      out_.push_back(Mismatch{step_, ev_, name, Str(expected), Str(actual)});
+    }
+  }
+  void Text(const char* name, const std::string& expected, const std::string& actual) {
+    if (expected != actual) {
+      out_.push_back(Mismatch{step_, ev_, name, expected, actual});
+    }
+  }
+  void Outputs(const rc::Expected& e, rr::LinkState link, bool emergency_brake, bool tracking_abnormal) {
+    Text("link", rr::ToString(e.link), rr::ToString(link));
+    if (e.eb) {
+      Field("eb", *e.eb, emergency_brake);
+    }
+    if (e.abnormal) {
+      Text("tracking", Tracking(*e.abnormal), Tracking(tracking_abnormal));
+    }
+  }
+ private:
+  std::size_t step_;
+  const char* ev_;
+  std::vector<Mismatch>& out_;
+};
+
+rr::EndpointConfig ConfigFor(const rc::FileHeader& h, rr::Role role) {
+  rr::EndpointConfig c{};
+  c.role = role;
+  c.own_id = role == rr::Role::kGround ? h.ground_id : h.train_id;
+  c.peer_id = role == rr::Role::kGround ? h.train_id : h.ground_id;
+  c.seq_modulus = h.seq_modulus;
+  c.seq_window = h.seq_window;
+  c.history_depth = h.history_depth;
+  c.turnaround_ms = h.turnaround_ms;
+  c.link_timeout_ms = h.link_timeout_ms;
+  c.echo_validity_ms = h.echo_validity_ms;
+  c.initial_seq = h.init_own_seq;
+  return c;
+}
+
+// Payload bytes of a delivered telegram (a fixed function of the step index).
+std::array<std::uint8_t, 8> RxPayload(std::size_t step) {
+  std::array<std::uint8_t, 8> p{};
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    p[i] = static_cast<std::uint8_t>(0x30U + 11U * i + 7U * step);
+  }
+  return p;
+}
+
+// Replays one vector; returns the mismatches of the first diverging step (empty: passed).
+std::vector<Mismatch> Replay(const rc::Vector& v, const rc::FileHeader& h, std::string& setup_error) {
+  std::vector<Mismatch> mismatches;
+  const rr::LinkKey link_key(kLinkKeyBytes);
+  const rr::LinkKey attacker_key(kAttackerKeyBytes);
+  rr::Endpoint ep;
+  const rr::ConfigError config_error = ep.Init(ConfigFor(h, v.role), link_key);
+  if (config_error != rr::ConfigError::kNone) {
+    setup_error = std::string("the header parameters are rejected by Endpoint::Init: ") + rr::ToString(config_error);
+    return mismatches;
+  }
+  std::uint64_t clock = 0;
+  const std::array<std::uint8_t, 4> tick_payload = {0x54, 0x49, 0x43, 0x4b};
+  for (std::size_t i = 0; i < v.steps.size() && mismatches.empty(); ++i) {
+    const rc::Step& s = v.steps[i];
+    if (s.kind == rc::Step::Kind::kTick) {
+      clock += h.time_ms_per_tick;
+      const auto now = static_cast<std::uint32_t>(clock);
+      rr::EncodedFrame frame{};
+      const auto out = ep.Cycle(now, tick_payload, frame);
+      StepChecker check(i, "tick", mismatches);
+      check.Text("status", rr::ToString(rr::SendStatus::kSent), rr::ToString(out.status));
+      check.Field("tx.seq", std::uint64_t{s.out.tx_seq}, std::uint64_t{out.tx.seq});
+      const std::optional<std::uint32_t> echo = out.tx.echo_valid ? std::optional<std::uint32_t>(out.tx.echo) : std::nullopt;
+      check.Text("tx.echo", Str(s.out.tx_echo), Str(echo));
+      check.Outputs(s.out, out.link, out.emergency_brake, out.tracking_abnormal);
+      continue;
+    }
+    const auto now = static_cast<std::uint32_t>(clock);
+    rr::TelegramHeader header{};
+    header.version = rr::kVersion;
+    header.type = s.tg.type;
+    header.src = s.tg.src;
+    header.dst = s.tg.dst;
+    header.seq = s.tg.seq;
+    header.echo = s.tg.echo.value_or(0U);
+    header.echo_valid = s.tg.echo.has_value();
+    header.timestamp_ms = now;
+    const auto payload = RxPayload(i);
+    rr::EncodedFrame frame{};
+    if (rr::EncodeFrame(header, payload, s.tg.with_link_key ? link_key : attacker_key, frame) !=
+        rr::EncodeStatus::kOk) {
+      setup_error = "step " + std::to_string(i) + ": EncodeFrame failed";
+      return mismatches;
+    }
+    if (s.tg.corrupt) {
+      for (std::size_t k = 0; k < kCorruptSymbols; ++k) {
+        frame.bytes[k * kCorruptStride] = static_cast<std::uint8_t>(frame.bytes[k * kCorruptStride] ^ 0xA5U);
+      }
+    }
+    std::array<std::uint8_t, rr::kPayloadMax> payload_out{};
+    const auto r = ep.Receive(now, frame.View(), payload_out);
+    StepChecker check(i, "rx", mismatches);
+    check.Text("verdict", rc::ToString(s.out.verdict), rc::ToString(rc::VerdictOf(r.reason)));
+    check.Field("gap", std::uint64_t{s.out.gap}, std::uint64_t{r.gap});
+    check.Outputs(s.out, r.link, r.emergency_brake, r.tracking_abnormal);
+    if (r.reason == rr::RejectReason::kNone) {
+      // The accepted content is exactly what was sent.
+      header.payload_len = static_cast<std::uint16_t>(payload.size());
+      check.Field("accepted header", true, r.header == header);
+      check.Field("accepted payload", true, std::equal(payload.begin(), payload.end(), payload_out.begin()));
+    } else {
+      check.Field("rejected payload zeroed", true,
+                  std::all_of(payload_out.begin(), payload_out.end(), [](std::uint8_t b) { return b == 0; }));
+    }
+  }
+  return mismatches;
+}
+
+class VectorTest : public testing::Test {
+ public:
+  explicit VectorTest(std::size_t index) : index_(index) {}
+  void TestBody() override {
+    const rc::Vector& v = g_set.vectors[index_];
+    const rc::FileHeader& h = g_set.headers[v.header_index];
+    RecordProperty("vector_id", v.id);
+    std::string reqs;
+    for (const auto& r : v.requirements) {
+      reqs += (reqs.empty() ? "" : " ") + r;
+    }
+    RecordProperty("requirements", reqs);
+    RecordProperty("goal", v.goal);
+    std::string setup_error;
+    g_replayed.fetch_add(1);
+    const auto mismatches = Replay(v, h, setup_error);
+    if (!setup_error.empty()) {
+      g_mismatched.fetch_add(1);
+      ADD_FAILURE_AT(v.file.c_str(), static_cast<int>(v.line)) << "vector " << v.id << ": " << setup_error;
+      return;
+    }
+    if (!mismatches.empty()) {
+      g_mismatched.fetch_add(1);
+    }
+    for (const Mismatch& m : mismatches) {
+      ADD_FAILURE_AT(v.file.c_str(), static_cast<int>(v.line))
+          << "vector " << v.id << " step " << m.step << " (" << m.ev << "): field " << m.field << ": expected "
+          << m.expected << ", actual " << m.actual;
+    }
+  }
+
+ private:
+  std::size_t index_;
+};
+
+
+void Usage(std::FILE* out) {
+  std::fprintf(out,
+               "usage: railproof_conformance --vectors DIR [--junit FILE] [gtest flags]\n"
+               "Replays every vector of DIR/*.jsonl (spec/design/tg.md §7) against the\n"
+               "radio endpoint; one test per vector. --junit FILE writes JUnit XML (same as\n"
+               "--gtest_output=xml:FILE); other --gtest_* flags are passed to GoogleTest.\n"
+               "Exit status 0 only if the set is non-empty, well formed and every vector passes;\n"
+               "1 if not; 2 on bad arguments.\n");
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  // Own flags first; everything else goes to GoogleTest (--junit becomes --gtest_output,
+  // which GoogleTest reads during InitGoogleTest).
+  const rcli::RunnerArgs args = rcli::ParseArgsAndInitGoogleTest("railproof-conformance-tg", argc, argv, Usage);
+  if (args.exit_code >= 0) {
+    return args.exit_code;
+  }
+  const std::string& vectors_dir = args.vectors_dir;
+
+  rc::LoadResult loaded = rc::LoadVectorDirectory(vectors_dir);
+  std::size_t files = 0;
+  {
+    std::vector<std::string> names;
+    for (const auto& h : loaded.set.headers) {
+      names.push_back(h.file);
+    }
+    std::sort(names.begin(), names.end());
+    files = static_cast<std::size_t>(std::unique(names.begin(), names.end()) - names.begin());
+  }
+  if (loaded.ok) {
+    g_set = std::move(loaded.set);
+  }
+  const std::size_t vector_count = g_set.vectors.size();
+  testing::RegisterTest("TelegramConformance", "VectorSet", nullptr, nullptr, __FILE__, __LINE__,
+                        [error = loaded.error, files, vector_count]() -> testing::Test* {
+                          return new rcli::VectorSetTest(error, files, vector_count);
+                        });
+  for (std::size_t i = 0; i < vector_count; ++i) {
+    const rc::Vector& v = g_set.vectors[i];
+    testing::RegisterTest("TelegramConformance", v.test_name.c_str(), nullptr, nullptr, v.file.c_str(),
+                          static_cast<int>(v.line), [i]() -> testing::Test* { return new VectorTest(i); });
+  }
+  rcli::ReportLoad("railproof-conformance-tg", loaded.ok, loaded.error, vector_count, files, vectors_dir);
+  const int rc_tests = RUN_ALL_TESTS();
+  return rcli::Finish("railproof-conformance-tg", loaded.ok, loaded.error, g_mismatched.load(), g_replayed.load(), vector_count, rc_tests);
+}

@@ -1,0 +1,383 @@
+// Reader of the conformance vectors (spec/design/tg.md §7).
+#include "vector_reader.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <fstream>
+#include <limits>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+#include <system_error>
+
+#include <nlohmann/json.hpp>
+
+namespace railproof::conformance {
+namespace {
+
+using nlohmann::json;
+namespace rr = railproof::tg;
+
+// Thrown inside this file only; LoadVectorDirectory turns it into an error line.
+struct FormatError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+const json& Field(const json& object, const char* key, const std::string& where) {
+  if (!object.is_object()) {
+    throw FormatError(where + " is not a JSON object");
+  }
+  const auto it = object.find(key);
+  if (it == object.end()) {
+    throw FormatError("missing field \"" + std::string(where.empty() ? "" : where + ".") + key + "\"");
+  }
+  return *it;
+}
+
+std::string Name(const std::string& where, const char* key) {
+  return where.empty() ? std::string(key) : where + "." + key;
+}
+
+std::uint64_t Unsigned(const json& object, const char* key, const std::string& where, std::uint64_t max) {
+  const json& v = Field(object, key, where);
+  if (!v.is_number_unsigned() && !(v.is_number_integer() && v.get<std::int64_t>() >= 0)) {
+    throw FormatError("field \"" + Name(where, key) + "\" is not a non-negative integer");
+  }
+  const auto value = v.get<std::uint64_t>();
+  if (value > max) {
+    throw FormatError("field \"" + Name(where, key) + "\" = " + std::to_string(value) + " exceeds " +
+                      std::to_string(max));
+  }
+  return value;
+}
+
+std::uint32_t U32(const json& object, const char* key, const std::string& where) {
+  return static_cast<std::uint32_t>(Unsigned(object, key, where, std::numeric_limits<std::uint32_t>::max()));
+}
+
+std::uint16_t U16(const json& object, const char* key, const std::string& where) {
+  return static_cast<std::uint16_t>(Unsigned(object, key, where, std::numeric_limits<std::uint16_t>::max()));
+}
+
+std::string String(const json& object, const char* key, const std::string& where) {
+  const json& v = Field(object, key, where);
+  if (!v.is_string()) {
+    throw FormatError("field \"" + Name(where, key) + "\" is not a string");
+  }
+  return v.get<std::string>();
+}
+
+bool Bool(const json& object, const char* key, const std::string& where) {
+  const json& v = Field(object, key, where);
+  if (!v.is_boolean()) {
+    throw FormatError("field \"" + Name(where, key) + "\" is not a boolean");
+  }
+  return v.get<bool>();
+}
+
+std::optional<std::uint32_t> OptionalU32(const json& object, const char* key, const std::string& where) {
+  const json& v = Field(object, key, where);
+  if (v.is_null()) {
+    return std::nullopt;
+  }
+  return U32(object, key, where);
+}
+
+template <typename T>
+T OneOf(const json& object, const char* key, const std::string& where,
+        std::initializer_list<std::pair<const char*, T>> choices) {
+  const std::string value = String(object, key, where);
+  for (const auto& [name, result] : choices) {
+    if (value == name) {
+      return result;
+    }
+  }
+  throw FormatError("field \"" + Name(where, key) + "\" has unknown value \"" + value + "\"");
+}
+
+void OnlyKeys(const json& object, const std::string& where, std::initializer_list<const char*> allowed) {
+  for (auto it = object.begin(); it != object.end(); ++it) {
+    const std::string& key = it.key();
+    if (std::none_of(allowed.begin(), allowed.end(), [&key](const char* a) { return key == a; })) {
+      throw FormatError("unknown field \"" + Name(where, key.c_str()) + "\"");
+    }
+  }
+}
+
+rr::LinkState ParseLink(const json& out, const std::string& where) {
+  return OneOf<rr::LinkState>(out, "link", where,
+                              {{"NONE", rr::LinkState::kNone}, {"UP", rr::LinkState::kUp}, {"LOST", rr::LinkState::kLost}});
+}
+
+void ParseRoleOutputs(const json& out, const std::string& where, rr::Role role, Expected& e) {
+  if (out.contains("eb")) {
+    e.eb = Bool(out, "eb", where);
+  }
+  if (out.contains("tracking")) {
+    e.abnormal = OneOf<bool>(out, "tracking", where, {{"TRACKED", false}, {"ABNORMAL", true}});
+  }
+  if (role == rr::Role::kTrain && !e.eb) {
+    throw FormatError("missing field \"" + Name(where, "eb") + "\" (train role)");
+  }
+  if (role == rr::Role::kGround && !e.abnormal) {
+    throw FormatError("missing field \"" + Name(where, "tracking") + "\" (ground role)");
+  }
+}
+
+Step ParseStep(const json& step, std::size_t index, rr::Role role) {
+  const std::string where = "steps[" + std::to_string(index) + "]";
+  OnlyKeys(step, where, {"in", "out"});
+  const json& in = Field(step, "in", where);
+  const json& out = Field(step, "out", where);
+  const std::string win = where + ".in";
+  const std::string wout = where + ".out";
+  Step s;
+  const std::string ev = String(in, "ev", win);
+  if (ev == "tick") {
+    OnlyKeys(in, win, {"ev"});
+    OnlyKeys(out, wout, {"tx", "link", "eb", "tracking"});
+    s.kind = Step::Kind::kTick;
+    const json& tx = Field(out, "tx", wout);
+    OnlyKeys(tx, wout + ".tx", {"seq", "echo"});
+    s.out.tx_seq = U32(tx, "seq", wout + ".tx");
+    s.out.tx_echo = OptionalU32(tx, "echo", wout + ".tx");
+  } else if (ev == "rx") {
+    OnlyKeys(in, win, {"ev", "tg"});
+    OnlyKeys(out, wout, {"verdict", "gap", "link", "eb", "tracking"});
+    s.kind = Step::Kind::kRx;
+    const json& tg = Field(in, "tg", win);
+    const std::string wtg = win + ".tg";
+    OnlyKeys(tg, wtg, {"src", "dst", "type", "seq", "echo", "auth", "integrity"});
+    s.tg.src = U16(tg, "src", wtg);
+    s.tg.dst = U16(tg, "dst", wtg);
+    s.tg.type = OneOf<rr::TelegramType>(tg, "type", wtg,
+                                        {{"CONTROL", rr::TelegramType::kControl},
+                                         {"POSITION", rr::TelegramType::kPosition}});
+    s.tg.seq = U32(tg, "seq", wtg);
+    s.tg.echo = OptionalU32(tg, "echo", wtg);
+    s.tg.with_link_key = OneOf<bool>(tg, "auth", wtg, {{"key", true}, {"nokey", false}});
+    s.tg.corrupt = OneOf<bool>(tg, "integrity", wtg, {{"ok", false}, {"corrupt", true}});
+    const std::string verdict = String(out, "verdict", wout);
+    const auto parsed = ParseVerdict(verdict);
+    if (!parsed) {
+      throw FormatError("field \"" + wout + ".verdict\" has unknown value \"" + verdict + "\"");
+    }
+    s.out.verdict = *parsed;
+    s.out.gap = U32(out, "gap", wout);
+  } else {
+    throw FormatError("field \"" + win + ".ev\" has unknown value \"" + ev + "\"");
+  }
+  s.out.link = ParseLink(out, wout);
+  ParseRoleOutputs(out, wout, role, s.out);
+  return s;
+}
+
+FileHeader ParseHeader(const json& h, const std::string& file) {
+  if (String(h, "kind", "") != "header") {
+    throw FormatError("first line is not a header (\"kind\":\"header\")");
+  }
+  if (Unsigned(h, "schema_version", "", 1000) != 1) {
+    throw FormatError("unsupported schema_version (expected 1)");
+  }
+  FileHeader fh;
+  fh.file = file;
+  fh.model = String(h, "model", "");
+  fh.model_sha256 = h.contains("model_sha256") && h["model_sha256"].is_string() ? h["model_sha256"].get<std::string>() : "";
+  fh.generator = h.contains("generator") && h["generator"].is_string() ? h["generator"].get<std::string>() : "";
+  const json& scales = Field(h, "unit_scales", "");
+  fh.time_ms_per_tick = U32(scales, "time_ms_per_tick", "unit_scales");
+  if (fh.time_ms_per_tick == 0) {
+    throw FormatError("unit_scales.time_ms_per_tick must be positive");
+  }
+  const json& p = Field(h, "parameters", "");
+  const std::string wp = "parameters";
+  fh.seq_modulus = Unsigned(p, "seq_modulus", wp, rr::kSeqModulusMax);
+  fh.seq_window = U32(p, "seq_window", wp);
+  fh.history_depth = U32(p, "history_depth", wp);
+  fh.turnaround_ms = U32(p, "turnaround_ms", wp);
+  fh.link_timeout_ms = U32(p, "link_timeout_ms", wp);
+  fh.echo_validity_ms = U32(p, "echo_validity_ms", wp);
+  fh.init_own_seq = U32(p, "init_own_seq", wp);
+  fh.ground_id = U16(p, "ground_id", wp);
+  fh.train_id = U16(p, "train_id", wp);
+  return fh;
+}
+
+Vector ParseVector(const json& v, const std::string& file, std::size_t line, std::size_t header_index) {
+  Vector vec;
+  vec.file = file;
+  vec.line = line;
+  vec.header_index = header_index;
+  vec.id = String(v, "id", "");
+  if (vec.id.empty()) {
+    throw FormatError("field \"id\" is empty");
+  }
+  vec.test_name = SanitizeTestName(vec.id);
+  vec.role = OneOf<rr::Role>(v, "role", "", {{"ground", rr::Role::kGround}, {"train", rr::Role::kTrain}});
+  const json& reqs = Field(v, "requirements", "");
+  if (!reqs.is_array()) {
+    throw FormatError("field \"requirements\" is not an array");
+  }
+  for (const json& r : reqs) {
+    if (!r.is_string()) {
+      throw FormatError("field \"requirements\" holds a non-string");
+    }
+    vec.requirements.push_back(r.get<std::string>());
+  }
+  vec.goal = v.contains("goal") && v["goal"].is_string() ? v["goal"].get<std::string>() : "";
+  vec.kind = v.contains("kind") && v["kind"].is_string() ? v["kind"].get<std::string>() : "";
+  const json& steps = Field(v, "steps", "");
+  if (!steps.is_array() || steps.empty()) {
+    throw FormatError("field \"steps\" is not a non-empty array");
+  }
+  for (std::size_t i = 0; i < steps.size(); ++i) {
+    vec.steps.push_back(ParseStep(steps[i], i, vec.role));
+  }
+  return vec;
+}
+
+}  // namespace
+
+const char* ToString(Verdict verdict) noexcept {
+  switch (verdict) {
+    case Verdict::kAccept: return "ACCEPT";
+    case Verdict::kIntegrity: return "REJ_INTEGRITY";
+    case Verdict::kAddress: return "REJ_ADDRESS";
+    case Verdict::kAuth: return "REJ_AUTH";
+    case Verdict::kRepeated: return "REJ_REPEATED";
+    case Verdict::kSequence: return "REJ_SEQUENCE";
+    case Verdict::kNoEcho: return "REJ_NO_ECHO";
+    case Verdict::kUnknownEcho: return "REJ_UNKNOWN_ECHO";
+    case Verdict::kStale: return "REJ_STALE";
+  }
+  return "INVALID";
+}
+
+std::optional<Verdict> ParseVerdict(const std::string& name) {
+  for (const Verdict v : {Verdict::kAccept, Verdict::kIntegrity, Verdict::kAddress, Verdict::kAuth, Verdict::kRepeated,
+                          Verdict::kSequence, Verdict::kNoEcho, Verdict::kUnknownEcho, Verdict::kStale}) {
+    if (name == ToString(v)) {
+      return v;
+    }
+  }
+  return std::nullopt;
+}
+
+Verdict VerdictOf(rr::RejectReason reason) noexcept {
+  switch (reason) {
+    case rr::RejectReason::kNone: return Verdict::kAccept;
+    case rr::RejectReason::kBadLength:
+    case rr::RejectReason::kRsUncorrectable:
+    case rr::RejectReason::kBadFormat:
+    case rr::RejectReason::kCrcMismatch: return Verdict::kIntegrity;
+    case rr::RejectReason::kWrongAddress: return Verdict::kAddress;
+    case rr::RejectReason::kAuthFailed: return Verdict::kAuth;
+    case rr::RejectReason::kRepeated: return Verdict::kRepeated;
+    case rr::RejectReason::kOutOfSequence: return Verdict::kSequence;
+    case rr::RejectReason::kNoEcho: return Verdict::kNoEcho;
+    case rr::RejectReason::kUnknownEcho: return Verdict::kUnknownEcho;
+    case rr::RejectReason::kStale: return Verdict::kStale;
+  }
+  return Verdict::kIntegrity;
+}
+
+std::string SanitizeTestName(const std::string& id) {
+  std::string name = id;
+  for (char& c : name) {
+    if (std::isalnum(static_cast<unsigned char>(c)) == 0) {
+      c = '_';
+    }
+  }
+  return name;
+}
+
+bool ParseVectorFile(const std::string& file_name, const std::string& text, VectorSet& set, std::string& error) {
+  std::istringstream lines(text);
+  std::string line;
+  std::size_t line_no = 0;
+  std::optional<std::size_t> header_index;
+  std::set<std::string> names;
+  for (const Vector& v : set.vectors) {
+    names.insert(v.test_name);
+  }
+  while (std::getline(lines, line)) {
+    ++line_no;
+    if (!line.empty() && line.back() == '\r') {
+      line.pop_back();
+    }
+    if (std::all_of(line.begin(), line.end(), [](unsigned char c) { return std::isspace(c) != 0; })) {
+      continue;
+    }
+    try {
+      const json j = json::parse(line);
+      if (!header_index) {
+        set.headers.push_back(ParseHeader(j, file_name));
+        header_index = set.headers.size() - 1;
+        continue;
+      }
+      Vector v = ParseVector(j, file_name, line_no, *header_index);
+      if (!names.insert(v.test_name).second) {
+        throw FormatError("duplicate vector id / test name \"" + v.test_name + "\"");
+      }
+      set.vectors.push_back(std::move(v));
+    } catch (const json::exception& e) {
+      error = file_name + ":" + std::to_string(line_no) + ": malformed JSON: " + e.what();
+      return false;
+    } catch (const FormatError& e) {
+      error = file_name + ":" + std::to_string(line_no) + ": " + e.what();
+      return false;
+    }
+  }
+  if (!header_index) {
+    error = file_name + ": no header line (empty file)";
+    return false;
+  }
+  return true;
+}
+
+LoadResult LoadVectorDirectory(const std::filesystem::path& dir) {
+  LoadResult result;
+  std::error_code ec;
+  if (!std::filesystem::is_directory(dir, ec)) {
+    result.error = "vector directory " + dir.string() + " does not exist or is not a directory";
+    return result;
+  }
+  std::vector<std::filesystem::path> files;
+  for (const auto& entry : std::filesystem::directory_iterator(dir, ec)) {
+    // tg*.jsonl: the telegram-layer vectors (other models' files are replayed by
+    // their own runners, e.g. railproof_conformance_mb for mb*.jsonl)
+    if (entry.is_regular_file() && entry.path().extension() == ".jsonl" &&
+        entry.path().filename().string().rfind("tg", 0) == 0) {
+      files.push_back(entry.path());
+    }
+  }
+  if (ec) {
+    result.error = "cannot list vector directory " + dir.string() + ": " + ec.message();
+    return result;
+  }
+  std::sort(files.begin(), files.end());
+  if (files.empty()) {
+    result.error = "no *.jsonl vector file in " + dir.string() + " (tg*.jsonl)";
+    return result;
+  }
+  for (const auto& path : files) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) {
+      result.error = path.string() + ": cannot be read";
+      return result;
+    }
+    std::ostringstream text;
+    text << in.rdbuf();
+    if (!ParseVectorFile(path.string(), text.str(), result.set, result.error)) {
+      return result;
+    }
+  }
+  if (result.set.vectors.empty()) {
+    result.error = "no vector in the " + std::to_string(files.size()) + " *.jsonl file(s) of " + dir.string();
+    return result;
+  }
+  result.ok = true;
+  return result;
+}
+
+}  // namespace railproof::conformance

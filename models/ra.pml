@@ -1,0 +1,639 @@
+/*
+ * railproof — re-adhesion state machine of the on-board odometry: slip/slide detection,
+ * parallel compensation start points, re-adhesion judgement, maximum compensation time,
+ * margin in force per odometry section, sensor failure and the stop demand (D1 chapter 3,
+ * D1 §5.2; spec/design/ra.md §5; C++: ra::ReadhesionMachine::Step,
+ * cpp/runtime/ra/src/readhesion_machine.cpp).
+ *
+ * What is modelled. One 100 ms odometry cycle of the state machine and the state it keeps
+ * between cycles: the mode (TG odometry, compensating, stopped), the stop reason, the
+ * deviation counter, up to two candidates (active, age in cycles, confirmation counter),
+ * the episode limits (maximum compensation time t_max in force and margin in force), the
+ * stop demand and the position validity. The signal processing (design note §3) is
+ * abstracted into the predicates of design note §4, chosen by the environment every
+ * cycle: deviation, speed_agrees[0..1], imu_ok, tg_ok, balise, the odometry section under
+ * the train and the age of the primary start point (MODEL_START_AGE + 0..MODEL_SEARCH_EXTRA,
+ * the look-back plus the start-point search; read only in a detection cycle). Model ticks
+ * are cycles and the abstract margins are fed to the C++ as mm unchanged, which is exact:
+ * the machine only compares ages with t_max and takes minima and maxima of the limits.
+ *
+ * Sections. Three kinds, any of them under the train in any cycle: a normal section
+ * (t_max MODEL_TMAX_LONG, margin MODEL_MARGIN_LONG), a steep section that keeps the normal
+ * time (MODEL_TMAX_LONG, the largest margin MODEL_MARGIN_STEEP) and a tight section with a
+ * shortened time (MODEL_TMAX_SHORT, the smallest margin MODEL_MARGIN_SHORT). So an episode
+ * can meet a larger margin, a shorter time, or both, in any order.
+ *
+ * Environment. Every cycle the section, imu_ok, tg_ok and balise are chosen freely. An
+ * input that the cycle of the design note does not read in the current situation is not
+ * varied in the exhaustive searches (verification and trap goals), it is fixed to 0 (or
+ * the look-back age): the deviation in the stopped state or with a failed sensor, the
+ * speed agreement outside compensation, the start-point age outside a possible detection
+ * cycle (TG odometry, healthy sensors, deviation). Every value of every input that is
+ * read is among the choices in every reachable state. The random walks (WALK) choose every
+ * input every cycle, so the vectors also show that the C++ ignores the others; their
+ * choices are weighted (CHOOSE_OK and the others below) so that a walk of MODEL_CYCLES
+ * cycles reaches detections, compensation, re-adhesion and timeouts.
+ *
+ * The cycle runs in the order of design note §5 (cycle() below, step numbers as there).
+ * The properties are evaluated by check() after every cycle on the state before it, the
+ * inputs, the state after it and ghost variables that follow the inputs only, never the
+ * machine's counters: g_run (consecutive deviations in TG odometry with healthy sensors),
+ * g_sage and g_since (start-point age at detection and cycles since it: a candidate's true
+ * age), g_seen (the section kinds under the train in every cycle of the episode), g_hist
+ * (per candidate, the last MODEL_CONFIRM cycles' "no deviation and speed agrees" bits).
+ * Violations are latched in v_* bits; each LTL property says one of them never becomes 1.
+ * Inputs, outputs and scratch values are cleared at the end of the cycle so that the
+ * stored state is the machine's state and the ghosts only; the search is exhaustive over
+ * unbounded runs.
+ *
+ * Configurations (-D): default = two parallel start points (verification and trap
+ * goals; TRAPS adds the goal flags); ONE_START = one start point (a boundary variant:
+ * every property is verified in it too, and it supplies the vectors of
+ * readhesion.one_start.jsonl); WALK stops after MODEL_CYCLES cycles (random-walk vectors).
+ *
+ * Annotations read by testgen: see models/tg.pml.
+ */
+#include "ra_params.pml"
+
+#define CONFIRM MODEL_CONFIRM
+#define SPACING MODEL_SPACING
+#if MODEL_CONFIRM < 2 || MODEL_CONFIRM > 7
+#error "the ghost history g_hist holds up to 7 cycles and the goals need MODEL_CONFIRM >= 2"
+#endif
+#if MODEL_TMAX_SHORT > MODEL_TMAX_LONG || MODEL_MARGIN_STEEP < MODEL_MARGIN_LONG
+#error "section kinds: the tight section has the shorter time, the steep one the larger margin"
+#endif
+#ifdef ONE_START
+#define NSP 1
+#else
+#define NSP 2
+#endif
+#define HMASK ((1 << CONFIRM) - 1)
+
+/* modes and stop reasons (ra::Mode, ra::StopReason, in order) */
+#define M_TG 0
+#define M_COMP 1
+#define M_STOP 2
+#define R_NONE 0
+#define R_MAXT 1
+#define R_IMU 2
+#define R_TG 3
+#define NONE 255
+/* section kinds: limits (T_s cycles, M_s margin units) */
+#define S_LONG 0
+#define S_STEEP 1
+#define S_SHORT 2
+#define SEC_T(k) ((k) == S_SHORT -> MODEL_TMAX_SHORT : MODEL_TMAX_LONG)
+#define SEC_M(k) ((k) == S_LONG -> MODEL_MARGIN_LONG : ((k) == S_STEEP -> MODEL_MARGIN_STEEP : MODEL_MARGIN_SHORT))
+
+/* ---- machine state (ra::MachineState) ------------------------------------------- */
+byte mode, reason, dcount;
+bit act[2];                /* candidates: active, age (cycles), confirmation counter */
+byte age[2], conf[2];
+byte tmax, margin;         /* maximum compensation time and margin in force */
+bit stop, valid = 1;
+/* ---- events of the cycle (cleared at its end) ------------------------------------------ */
+bit detected, breset;
+byte adopted = NONE;
+/* ---- inputs of the cycle (cleared at its end) ------------------------------------------ */
+bit dev, sa[2], imu, tg, bal;
+byte sec, sage;
+/* ---- scratch: the state at the start of the cycle, loop index (cleared at its end) ----- */
+byte was_mode, was_reason, was_dcount, was_tmax, was_margin, c;
+bit was_act[2];
+byte was_conf[2];
+#ifdef MUTANT_MARGIN_LATE
+byte late_m;               /* mutant only: the previous cycle's section margin */
+#endif
+#ifdef WALK
+byte ncycles;
+#endif
+/* ---- ghost: follows the inputs only ---------------------------------------------------- */
+byte g_run;                /* consecutive deviations in TG odometry with healthy sensors */
+bit g_ep;                  /* an episode (detection ... end of compensation) is running */
+byte g_sage, g_since;      /* start-point age at detection, cycles since the detection */
+byte g_seen;               /* bit k: section kind k under the train in a cycle of the episode */
+byte g_hist[2];            /* per candidate: the last CONFIRM "no deviation and speed agrees" bits */
+byte g_mint, g_mmax;       /* scratch: shortest time and largest margin of g_seen */
+/* ---- ghost: latched property violations ----------------------------------------------- */
+bit v_detect, v_start, v_readh, v_timeout, v_stopped, v_limits, v_parallel, v_balise, v_sensor;
+#ifdef TRAPS
+bit g[48];
+byte h_i;
+/* goal flags mark the goals reached in the last cycle only (cleared at the start of each
+ * cycle), so that they do not multiply the states of the breadth-first trap searches */
+#define GOAL(k) g[k] = 1
+#define CLEAR_GOALS d_step { for (h_i : 0 .. 47) { g[h_i] = 0 }; h_i = 0 }
+#else
+#define CLEAR_GOALS skip
+#define GOAL(k) skip
+#endif
+
+#define HEALTHY (imu && tg)
+/* a candidate's true age (ghost) and whether it is within every t_max of the episode */
+#define TRUE_AGE(k) (g_sage + (k) * SPACING + g_since)
+#define ALIVE(k) ((k) < NSP && g_ep && TRUE_AGE(k) <= g_mint)
+#define FULL(k) ((g_hist[k] & HMASK) == HMASK)
+
+#define CHOOSE_BIT(b) if :: b = 0 :: b = 1 fi
+#define CHOOSE_SEC(s) if :: s = S_LONG :: s = S_STEEP :: s = S_SHORT fi
+#define CHOOSE_AGE(a) \
+  if \
+  :: a = MODEL_START_AGE \
+  :: (MODEL_SEARCH_EXTRA >= 1) -> a = MODEL_START_AGE + 1 \
+  :: (MODEL_SEARCH_EXTRA >= 2) -> a = MODEL_START_AGE + 2 \
+  :: (MODEL_SEARCH_EXTRA >= 3) -> a = MODEL_START_AGE + 3 \
+  fi
+#if MODEL_SEARCH_EXTRA > 3
+#error "CHOOSE_AGE enumerates up to MODEL_SEARCH_EXTRA = 3: extend it"
+#endif
+#ifdef WALK
+/* random walks: a sensor fails in 1 of 32 cycles, a balise is read in 1 of 4; a deviation
+ * in 3 of 4 cycles outside compensation and in 1 of 4 while compensating, the speed
+ * agreement in 3 of 4, so that a walk reaches detections, re-adhesion and timeouts */
+#define CHOOSE_OK(b) \
+  if \
+  :: b = 0 :: b = 1 :: b = 1 :: b = 1 :: b = 1 :: b = 1 :: b = 1 :: b = 1 \
+  :: b = 1 :: b = 1 :: b = 1 :: b = 1 :: b = 1 :: b = 1 :: b = 1 :: b = 1 \
+  :: b = 1 :: b = 1 :: b = 1 :: b = 1 :: b = 1 :: b = 1 :: b = 1 :: b = 1 \
+  :: b = 1 :: b = 1 :: b = 1 :: b = 1 :: b = 1 :: b = 1 :: b = 1 :: b = 1 \
+  fi
+#define CHOOSE_BALISE(b) if :: b = 1 :: b = 0 :: b = 0 :: b = 0 fi
+#define CHOOSE_LIKELY(b) if :: b = 1 :: b = 1 :: b = 1 :: b = 0 fi
+#define CHOOSE_UNLIKELY(b) if :: b = 1 :: b = 0 :: b = 0 :: b = 0 fi
+#else
+#define CHOOSE_OK(b) CHOOSE_BIT(b)
+#define CHOOSE_BALISE(b) CHOOSE_BIT(b)
+#endif
+
+/* ---- the cycle, design note §5 --------------------------------------------------------- */
+inline discard() {
+  act[0] = 0; age[0] = 0; conf[0] = 0;
+  act[1] = 0; age[1] = 0; conf[1] = 0
+}
+
+/* step 6: the safe reaction of the timeout */
+inline stop_timeout() {
+  discard();
+  mode = M_STOP; reason = R_MAXT; stop = 1;
+#ifndef MUTANT_STOP_POSITION_VALID
+  valid = 0
+#else
+  skip
+#endif
+}
+
+#if defined(MUTANT_DETECT_EARLY)
+#define DETECT_AT (CONFIRM - 1)
+#elif defined(MUTANT_DETECT_LATE)
+#define DETECT_AT (CONFIRM + 1)
+#else
+#define DETECT_AT CONFIRM
+#endif
+#if defined(MUTANT_START_AT_DETECTION)
+#define START_OF(k) ((k) * SPACING)
+#elif defined(MUTANT_NO_SPACING)
+#define START_OF(k) sage
+#else
+#define START_OF(k) (sage + (k) * SPACING)
+#endif
+#ifdef MUTANT_TIMEOUT_OFF_BY_ONE
+#define AGE_LIMIT (tmax + 1)
+#else
+#define AGE_LIMIT tmax
+#endif
+#ifdef MUTANT_CONFIRM_TWO
+#define NEEDED (CONFIRM - 1)
+#else
+#define NEEDED CONFIRM
+#endif
+#if defined(MUTANT_SPEED_IGNORED)
+#define BOTH(k) (!dev)
+#elif defined(MUTANT_DEVIATION_IGNORED)
+#define BOTH(k) (sa[k])
+#else
+#define BOTH(k) (!dev && sa[k])
+#endif
+#ifdef MUTANT_TG_FAILURE_IGNORED
+#define FAILED (!imu)
+#else
+#define FAILED (!imu || !tg)
+#endif
+
+inline cycle() {
+  /* 1. section limits: an episode never relaxes them */
+#if defined(MUTANT_EPISODE_RELAXES)
+  tmax = SEC_T(sec); margin = SEC_M(sec);
+#elif defined(MUTANT_MARGIN_LATE)
+  if
+  :: was_mode == M_COMP ->
+     if :: SEC_T(sec) < tmax -> tmax = SEC_T(sec) :: else -> skip fi;
+     if :: late_m > margin -> margin = late_m :: else -> skip fi
+  :: else -> tmax = SEC_T(sec); margin = late_m
+  fi;
+  late_m = SEC_M(sec);
+#else
+  if
+  :: was_mode == M_COMP ->
+     if :: SEC_T(sec) < tmax -> tmax = SEC_T(sec) :: else -> skip fi;
+     if :: SEC_M(sec) > margin -> margin = SEC_M(sec) :: else -> skip fi
+  :: else -> tmax = SEC_T(sec); margin = SEC_M(sec)
+  fi;
+#endif
+  if
+  :: FAILED ->                          /* 2. sensor failure: stop, IMU checked first */
+     dcount = 0;
+#ifndef MUTANT_FAILURE_KEEPS_CANDIDATES
+     discard();
+#endif
+     mode = M_STOP; stop = 1; valid = 0;
+     reason = (!imu -> R_IMU : R_TG)
+  :: else ->
+     if
+     :: mode == M_STOP ->               /* 3. held until a balise */
+        stop = 1; valid = 0;
+        if
+#ifdef MUTANT_RELEASED_WITHOUT_BALISE
+        :: true ->
+#else
+        :: bal ->
+#endif
+           mode = M_TG; reason = R_NONE; stop = 0; valid = 1; dcount = 0; breset = 1
+        :: else -> skip
+        fi
+     :: mode == M_TG ->                 /* 4. detection */
+        if :: dev -> dcount++ :: else -> dcount = 0 fi;
+#ifndef MUTANT_BALISE_IGNORED_IN_TG
+        if :: bal -> breset = 1 :: else -> skip fi;
+#endif
+        if
+        :: dcount == DETECT_AT ->
+           dcount = 0; detected = 1; mode = M_COMP;
+           act[0] = 1; age[0] = START_OF(0); conf[0] = 0;
+           if
+           :: NSP == 2 -> act[1] = 1; age[1] = START_OF(1); conf[1] = 0
+           :: else -> skip
+           fi;
+           c = 0;                       /* a start point older than t_max: discarded at once */
+           do
+           :: c < 2 ->
+              if
+              :: act[c] && age[c] > tmax -> act[c] = 0; age[c] = 0; conf[c] = 0
+              :: else -> skip
+              fi;
+              c++
+           :: else -> break
+           od;
+           if :: !act[0] && !act[1] -> stop_timeout() :: else -> skip fi
+        :: else -> skip
+        fi
+     :: mode == M_COMP ->               /* 5. age, timeout, re-adhesion judgement */
+        c = 0;
+        do
+        :: c < 2 ->
+           if
+           :: act[c] ->
+              age[c]++;
+              if
+              :: age[c] > AGE_LIMIT -> act[c] = 0; age[c] = 0; conf[c] = 0
+              :: else ->
+                 if
+                 :: BOTH(c) -> if :: conf[c] < NEEDED -> conf[c]++ :: else -> skip fi
+#ifdef MUTANT_CONFIRM_NOT_RESET
+                 :: else -> skip
+#else
+                 :: else -> conf[c] = 0
+#endif
+                 fi
+              fi
+           :: else -> skip
+           fi;
+           c++
+        :: else -> break
+        od;
+        /* the lowest index that completed its confirmation is adopted */
+        if
+#ifdef MUTANT_LAST_CANDIDATE_WINS
+        :: act[1] && conf[1] >= NEEDED -> adopted = 1
+#endif
+        :: act[0] && conf[0] >= NEEDED -> adopted = 0
+        :: else ->
+           if
+           :: act[1] && conf[1] >= NEEDED -> adopted = 1
+           :: else -> skip
+           fi
+        fi;
+        if
+        :: adopted != NONE ->
+#ifdef MUTANT_OTHER_KEPT
+           act[adopted] = 0; age[adopted] = 0; conf[adopted] = 0;
+#else
+           discard();
+#endif
+           mode = M_TG; dcount = 0
+        :: else ->
+           if :: !act[0] && !act[1] -> stop_timeout() :: else -> skip fi   /* 6. */
+        fi
+     fi
+  fi
+}
+
+/* ---- ghost update from the inputs, then the properties --------------------------------- */
+inline ghost() {
+  /* sections of the episode (the detection cycle and every compensating cycle after it) */
+  g_seen = (was_mode == M_COMP -> g_seen : 0) | (1 << sec);
+  g_mint = 255; g_mmax = 0;
+  c = 0;
+  do
+  :: c < 3 ->
+     if
+     :: (g_seen >> c) & 1 ->
+        if :: SEC_T(c) < g_mint -> g_mint = SEC_T(c) :: else -> skip fi;
+        if :: SEC_M(c) > g_mmax -> g_mmax = SEC_M(c) :: else -> skip fi
+     :: else -> skip
+     fi;
+     c++
+  :: else -> break
+  od;
+  /* consecutive deviations in TG odometry with healthy sensors */
+  if
+  :: was_mode == M_TG && HEALTHY && dev -> g_run++
+  :: else -> g_run = 0
+  fi;
+  /* the episode: begins when the deviations reach CONFIRM, then one cycle per cycle */
+  if
+  :: was_mode == M_TG && g_run == CONFIRM ->
+     g_ep = 1; g_sage = sage; g_since = 0; g_hist[0] = 0; g_hist[1] = 0
+  :: was_mode == M_COMP && HEALTHY && g_ep ->
+     g_since++;
+     g_hist[0] = ((g_hist[0] << 1) | (!dev && sa[0])) & HMASK;
+     g_hist[1] = ((g_hist[1] << 1) | (!dev && sa[1])) & HMASK
+  :: else -> g_ep = 0
+  fi;
+  if :: !ALIVE(0) -> g_hist[0] = 0 :: else -> skip fi;
+  if :: !ALIVE(1) -> g_hist[1] = 0 :: else -> skip fi
+}
+
+inline check() {
+  /* REQ-RA-003: in TG odometry with healthy sensors, the mode leaves TG exactly when
+   * CONFIRM consecutive deviations have been seen; the detection event exactly then;
+   * compensation only in an episode begun so */
+  if
+  :: was_mode == M_TG && HEALTHY && ((mode != M_TG) != (g_run == CONFIRM)) -> v_detect = 1
+  :: detected != (was_mode == M_TG && g_run == CONFIRM) -> v_detect = 1
+  :: mode == M_COMP && !g_ep -> v_detect = 1
+  :: else -> skip
+  fi;
+  /* REQ-RA-004 (REQ-RA-010): every candidate compensates from its start point: its age is
+   * the start-point age found at detection (the second start point MODEL_SPACING older)
+   * plus the cycles since the detection */
+  if
+  :: mode == M_COMP && act[0] && age[0] != TRUE_AGE(0) -> v_start = 1
+  :: mode == M_COMP && act[1] && age[1] != TRUE_AGE(1) -> v_start = 1
+  :: else -> skip
+  fi;
+  /* REQ-RA-006: a return to TG odometry from compensation only by an adoption, and the
+   * adopted candidate had no deviation and speed agreement in each of the last CONFIRM
+   * cycles since the detection */
+  if
+  :: was_mode == M_COMP && mode == M_TG && adopted == NONE -> v_readh = 1
+  :: adopted != NONE && !(adopted < NSP && FULL(adopted)) -> v_readh = 1
+  :: else -> skip
+  fi;
+  /* REQ-RA-007: while compensating, exactly the candidates whose true age is within every
+   * t_max of the episode are active, never older than t_max in force; when none is left
+   * (and none adopted), the stop demand and the invalid position in that cycle */
+  if
+  :: mode == M_COMP && (act[0] != ALIVE(0) || act[1] != ALIVE(1)) -> v_timeout = 1
+  :: mode == M_COMP && act[0] && age[0] > tmax -> v_timeout = 1
+  :: mode == M_COMP && act[1] && age[1] > tmax -> v_timeout = 1
+  :: g_ep && HEALTHY && !ALIVE(0) && !ALIVE(1) &&
+     !(mode == M_STOP && reason == R_MAXT && stop && !valid && adopted == NONE) -> v_timeout = 1
+  :: else -> skip
+  fi;
+  /* REQ-RA-007: stop demand and invalid position exactly in the stopped state (with a
+   * reason), held until a balise read with healthy sensors, which re-establishes TG */
+  if
+  :: stop != (mode == M_STOP) || valid != (mode != M_STOP) -> v_stopped = 1
+  :: (mode == M_STOP) != (reason != R_NONE) -> v_stopped = 1
+  :: was_mode == M_STOP && !(HEALTHY && bal) && mode != M_STOP -> v_stopped = 1
+  :: was_mode == M_STOP && HEALTHY && !bal && reason != was_reason -> v_stopped = 1
+  :: was_mode == M_STOP && HEALTHY && bal && mode != M_TG -> v_stopped = 1
+  :: else -> skip
+  fi;
+  /* REQ-RA-009: margin in force >= the margin and t_max in force <= the time of every
+   * section under the train in this cycle and in every cycle of the episode */
+  if
+  :: margin < g_mmax || tmax > g_mint -> v_limits = 1
+  :: else -> skip
+  fi;
+  /* REQ-RA-010: the adopted candidate is the lowest index that completed its confirmation
+   * (within t_max), in the first cycle any did; nothing stays active after the adoption */
+  if
+  :: was_mode == M_COMP && HEALTHY && g_ep &&
+     adopted != (ALIVE(0) && FULL(0) -> 0 : (ALIVE(1) && FULL(1) -> 1 : NONE)) -> v_parallel = 1
+  :: adopted != NONE && (act[0] || act[1] || mode != M_TG) -> v_parallel = 1
+  :: else -> skip
+  fi;
+  /* REQ-RA-012: a balise in TG odometry (and the one that ends a stop) resets the
+   * accumulated error; no reset without a balise, none while compensating */
+  if
+  :: (was_mode == M_TG || was_mode == M_STOP) && HEALTHY && bal && !breset -> v_balise = 1
+  :: breset && !(bal && HEALTHY && was_mode != M_COMP) -> v_balise = 1
+  :: else -> skip
+  fi;
+  /* REQ-RA-013: a sensor failure gives in the same cycle the stopped state with its
+   * reason (IMU first), the stop demand, the invalid position, no candidate, no adoption */
+  if
+  :: !HEALTHY && !(mode == M_STOP && stop && !valid && !act[0] && !act[1] && adopted == NONE &&
+                   reason == (!imu -> R_IMU : R_TG)) -> v_sensor = 1
+  :: else -> skip
+  fi
+}
+
+/* ---- coverage goals, from the state before the cycle, its inputs and outputs ----------- */
+#define ON(cond, k) if :: (cond) -> GOAL(k) :: else -> skip fi
+#define COMP_CYCLE (was_mode == M_COMP && HEALTHY)
+inline goals() {
+  ON(detected && act[0] && act[1], 0);
+  ON(was_mode == M_TG && HEALTHY && was_dcount == CONFIRM - 1 && !dev && mode == M_TG, 1);
+  ON(detected && breset, 2);
+  ON(detected && act[0] && age[0] == MODEL_START_AGE + MODEL_SEARCH_EXTRA, 3);
+  ON(adopted == 0 && g_since == CONFIRM, 4);
+  ON(COMP_CYCLE && was_act[0] && was_conf[0] == CONFIRM - 1 && dev && act[0] && conf[0] == 0, 5);
+  ON(COMP_CYCLE && was_act[0] && was_conf[0] > 0 && !dev && !sa[0] && act[0] && conf[0] == 0, 6);
+  ON(adopted != NONE && g_since > CONFIRM, 7);
+  ON(adopted == 1 && ALIVE(0), 8);
+  ON(adopted == 1 && ALIVE(0) && (g_hist[0] & (HMASK >> 1)) == (HMASK >> 1), 9);
+  ON(adopted == 0 && ALIVE(1) && FULL(1), 10);
+  ON(adopted == 0 && was_act[1] && !ALIVE(1), 11);
+  ON(mode == M_COMP && act[0] && age[0] == tmax, 12);
+  ON(COMP_CYCLE && mode == M_STOP && reason == R_MAXT && TRUE_AGE(0) == tmax + 1, 13);
+  ON(COMP_CYCLE && was_act[1] && !act[1] && act[0] && mode == M_COMP, 14);
+  ON(COMP_CYCLE && mode == M_STOP && reason == R_MAXT && tmax < was_tmax, 15);
+  ON(COMP_CYCLE && mode == M_COMP && tmax < was_tmax, 16);
+  ON(COMP_CYCLE && margin > was_margin, 17);
+  ON(COMP_CYCLE && mode == M_COMP && margin > SEC_M(sec), 18);
+  ON(COMP_CYCLE && mode == M_COMP && tmax < SEC_T(sec), 19);
+  ON(was_mode == M_TG && mode == M_TG && margin < was_margin, 20);
+  ON(was_mode == M_TG && !imu, 21);
+  ON(was_mode == M_COMP && !imu, 22);
+  ON(was_mode == M_STOP && was_reason == R_MAXT && !imu, 23);
+  ON(was_mode == M_TG && imu && !tg, 24);
+  ON(was_mode == M_COMP && imu && !tg, 25);
+  ON(was_mode == M_STOP && imu && !tg, 26);
+  ON(!imu && !tg, 27);
+  ON(was_mode == M_TG && HEALTHY && bal && mode == M_TG, 28);
+  ON(COMP_CYCLE && bal && mode == M_COMP, 29);
+  ON(was_mode == M_STOP && was_reason == R_MAXT && mode == M_TG, 30);
+  ON(was_mode == M_STOP && (was_reason == R_IMU || was_reason == R_TG) && mode == M_TG, 31);
+  ON(was_mode == M_STOP && bal && !HEALTHY, 32);
+  ON(was_mode == M_STOP && HEALTHY && !bal, 33);
+  ON(detected && mode == M_COMP && NSP == 2 && !act[1], 34);
+  ON(detected && mode == M_STOP, 35);
+  ON(adopted == 0 && NSP == 1, 36);
+  ON(COMP_CYCLE && mode == M_STOP && reason == R_MAXT && NSP == 1, 37);
+  ON(adopted != NONE && TRUE_AGE(adopted) == tmax, 38);
+  ON(COMP_CYCLE && was_conf[0] > 0 && was_conf[1] > 0 && dev && act[0] && act[1], 39)
+}
+
+inline clear_cycle() {
+  dev = 0; sa[0] = 0; sa[1] = 0; imu = 0; tg = 0; bal = 0; sec = 0; sage = 0;
+  detected = 0; breset = 0; adopted = NONE;
+  was_mode = 0; was_reason = 0; was_dcount = 0; was_tmax = 0; was_margin = 0; c = 0;
+  was_act[0] = 0; was_act[1] = 0; was_conf[0] = 0; was_conf[1] = 0;
+  g_mint = 0; g_mmax = 0;
+  /* ghosts outside their use: the run outside TG odometry, the episode outside compensation */
+  if :: mode != M_TG -> g_run = 0 :: else -> skip fi;
+  if
+  :: mode != M_COMP -> g_ep = 0; g_sage = 0; g_since = 0; g_seen = 0; g_hist[0] = 0; g_hist[1] = 0
+  :: else -> skip
+  fi
+}
+
+init {
+  do
+  :: atomic {
+#ifdef WALK
+       ncycles < MODEL_CYCLES -> ncycles++;
+#endif
+       CLEAR_GOALS;
+       /* the environment (see the header comment for the inputs fixed when not read) */
+       CHOOSE_SEC(sec); CHOOSE_OK(imu); CHOOSE_OK(tg); CHOOSE_BALISE(bal);
+#ifdef WALK
+       if :: mode == M_COMP -> CHOOSE_UNLIKELY(dev) :: else -> CHOOSE_LIKELY(dev) fi;
+       CHOOSE_LIKELY(sa[0]); CHOOSE_LIKELY(sa[1]); CHOOSE_AGE(sage);
+#else
+       if :: HEALTHY && mode != M_STOP -> CHOOSE_BIT(dev) :: else -> skip fi;
+       if
+       :: HEALTHY && mode == M_COMP ->
+          CHOOSE_BIT(sa[0]);
+          if :: NSP == 2 -> CHOOSE_BIT(sa[1]) :: else -> skip fi
+       :: else -> skip
+       fi;
+       if :: HEALTHY && mode == M_TG && dev -> CHOOSE_AGE(sage) :: else -> sage = MODEL_START_AGE fi;
+#endif
+       d_step {
+         printf("@IN cycle dev=%d sa0=%d sa1=%d imu=%d tg=%d bal=%d sec=%d age=%d\n",
+                dev, sa[0], sa[1], imu, tg, bal, sec, sage);
+         was_mode = mode; was_reason = reason; was_dcount = dcount; was_tmax = tmax;
+         was_margin = margin; was_act[0] = act[0]; was_act[1] = act[1];
+         was_conf[0] = conf[0]; was_conf[1] = conf[1];
+         cycle();
+         printf("@OUT mode=%d reason=%d dcount=%d a0=%d t0=%d c0=%d a1=%d t1=%d c1=%d tmax=%d margin=%d stop=%d valid=%d det=%d adopted=%d breset=%d\n",
+                mode, reason, dcount, act[0], age[0], conf[0], act[1], age[1], conf[1], tmax, margin,
+                stop, valid, detected, adopted, breset);
+         ghost();
+         check();
+         goals();
+         clear_cycle()
+       }
+     }
+  od
+}
+
+// @property REQ_RA_003_detection REQ-RA-003 : in TG odometry with healthy sensors a slip/slide is detected (the machine leaves TG odometry, detection event) exactly in the cycle that completes MODEL_CONFIRM consecutive deviations: never missed, never earlier; compensation only after such a detection
+ltl REQ_RA_003_detection { [] !v_detect }
+// @property REQ_RA_004_start_point REQ-RA-004 REQ-RA-010 : every candidate compensates from its start point: while compensating its age is the start-point age found at detection (MODEL_START_AGE + 0..MODEL_SEARCH_EXTRA, the second start point MODEL_SPACING cycles older) plus the cycles since the detection
+ltl REQ_RA_004_start_point { [] !v_start }
+// @property REQ_RA_006_readhesion REQ-RA-006 : compensation returns to TG odometry only by adopting a candidate that had no deviation and the speed agreement in each of the last MODEL_CONFIRM cycles since the detection (ghost history of the inputs)
+ltl REQ_RA_006_readhesion { [] !v_readh }
+// @property REQ_RA_007_timeout REQ-RA-007 : while compensating, exactly the candidates whose true age is within every maximum compensation time of the episode are active, never older than the t_max in force; in the cycle the last candidate times out (also at detection) the stop demand and the invalid position are given
+ltl REQ_RA_007_timeout { [] !v_timeout }
+// @property REQ_RA_007_stopped REQ-RA-007 REQ-RA-012 : the stop demand and the invalid position are given exactly in the stopped state, which keeps its reason and is held until a balise is read with both sensors healthy, which re-establishes TG odometry
+ltl REQ_RA_007_stopped { [] !v_stopped }
+// @property REQ_RA_009_limits REQ-RA-009 : the margin in force is never below, and the maximum compensation time in force never above, the limits of the section under the train in the current cycle and of every section of every cycle since the episode began
+ltl REQ_RA_009_limits { [] !v_limits }
+// @property REQ_RA_010_parallel REQ-RA-010 : the adopted candidate is the lowest index that completed its confirmation within its maximum compensation time, in the first cycle any did (the primary if both do in the same cycle); nothing stays active after the adoption
+ltl REQ_RA_010_parallel { [] !v_parallel }
+// @property REQ_RA_012_balise REQ-RA-012 : a balise read in TG odometry with healthy sensors (and the balise that ends a stop) resets the accumulated error in that cycle; there is no reset without a balise and none while compensating
+ltl REQ_RA_012_balise { [] !v_balise }
+// @property REQ_RA_013_sensor REQ-RA-013 : an IMU or TG failure gives in the same cycle the stopped state with the failure as reason (IMU checked first), the stop demand and the invalid position, and discards every candidate
+ltl REQ_RA_013_sensor { [] !v_sensor }
+
+// @variant ONE_START start_points=1 : one start point (parallel_start_points = 1): every property is verified with a single candidate too, and the configuration supplies the vectors of readhesion.one_start.jsonl
+
+// @mutant MUTANT_TIMEOUT_OFF_BY_ONE violates REQ_RA_007_timeout : a candidate times out only above t_max + 1 (C++ FAULT_RA_TIMEOUT_OFF_BY_ONE)
+// @mutant MUTANT_CONFIRM_TWO violates REQ_RA_006_readhesion : re-adhesion adopted after MODEL_CONFIRM - 1 confirming cycles (C++ FAULT_RA_CONFIRM_TWO)
+// @mutant MUTANT_SPEED_IGNORED violates REQ_RA_006_readhesion : the speed condition of the re-adhesion judgement is ignored (C++ FAULT_RA_SPEED_IGNORED)
+// @mutant MUTANT_EPISODE_RELAXES violates REQ_RA_009_limits : the episode takes the current section's limits only (C++ FAULT_RA_EPISODE_RELAXES)
+// @mutant MUTANT_LAST_CANDIDATE_WINS violates REQ_RA_010_parallel : the highest index wins when both candidates complete the confirmation in one cycle (C++ FAULT_RA_LAST_CANDIDATE_WINS)
+// @mutant MUTANT_TG_FAILURE_IGNORED violates REQ_RA_013_sensor : a TG failure does not stop the train (C++ FAULT_RA_TG_FAILURE_IGNORED)
+// @mutant MUTANT_START_AT_DETECTION violates REQ_RA_004_start_point : the compensation starts at the detection cycle instead of the start point found by the search
+// @mutant MUTANT_NO_SPACING violates REQ_RA_004_start_point : the second start point starts at the primary's age (no parallel spacing)
+// @mutant MUTANT_MARGIN_LATE violates REQ_RA_009_limits : the margin in force follows the section one cycle late
+// @mutant MUTANT_DETECT_EARLY violates REQ_RA_003_detection : detection after MODEL_CONFIRM - 1 consecutive deviations
+// @mutant MUTANT_DETECT_LATE violates REQ_RA_003_detection : detection only after MODEL_CONFIRM + 1 consecutive deviations (a slip missed)
+// @mutant MUTANT_STOP_POSITION_VALID violates REQ_RA_007_timeout : the timeout demands a stop without declaring the position invalid
+// @mutant MUTANT_RELEASED_WITHOUT_BALISE violates REQ_RA_007_stopped : the stopped state is left as soon as both sensors are healthy, without a balise
+// @mutant MUTANT_BALISE_IGNORED_IN_TG violates REQ_RA_012_balise : a balise in TG odometry does not reset the accumulated error
+// @mutant MUTANT_CONFIRM_NOT_RESET violates REQ_RA_006_readhesion : a cycle without both conditions does not restart the confirmation (non-consecutive cycles counted)
+// @mutant MUTANT_DEVIATION_IGNORED violates REQ_RA_006_readhesion : the deviation condition of the re-adhesion judgement is ignored
+// @mutant MUTANT_OTHER_KEPT violates REQ_RA_010_parallel : the candidate not adopted stays active after the adoption
+// @mutant MUTANT_FAILURE_KEEPS_CANDIDATES violates REQ_RA_013_sensor : a sensor failure stops the train but keeps the candidates
+
+// ---- coverage goals (trap properties): every branch of the cycle, each boundary ----
+// @goal 0 REQ-RA-003 REQ-RA-010 : detection after MODEL_CONFIRM consecutive deviations, both start points compensating
+// @goal 1 REQ-RA-003 : boundary: MODEL_CONFIRM - 1 consecutive deviations, then none: no detection, the count restarts
+// @goal 2 REQ-RA-003 REQ-RA-012 : detection in a cycle with a balise (accumulated error reset in the detection cycle)
+// @goal 3 REQ-RA-003 REQ-RA-004 : boundary: detection with the start point at the end of the search (age MODEL_START_AGE + MODEL_SEARCH_EXTRA)
+// @goal 4 REQ-RA-006 REQ-RA-010 : boundary: primary adopted at the first possible cycle, exactly MODEL_CONFIRM confirming cycles after the detection
+// @goal 5 REQ-RA-006 : boundary: MODEL_CONFIRM - 1 confirming cycles, then a deviation: the confirmation restarts
+// @goal 6 REQ-RA-006 : speed condition failing without a deviation: the confirmation restarts
+// @goal 7 REQ-RA-006 : re-adhesion after an interrupted confirmation (later than the first possible cycle)
+// @goal 8 REQ-RA-010 : the second start point is adopted while the primary is still compensating
+// @goal 9 REQ-RA-010 : boundary: the second start point wins with the primary one confirming cycle short
+// @goal 10 REQ-RA-010 : both start points complete the confirmation in the same cycle: the primary is adopted
+// @goal 11 REQ-RA-010 REQ-RA-007 : primary adopted in the cycle the second start point times out
+// @goal 12 REQ-RA-007 : boundary: the primary compensating at exactly t_max (still active)
+// @goal 13 REQ-RA-007 : boundary: the last candidate times out at t_max + 1: stop demand and invalid position in that cycle
+// @goal 14 REQ-RA-007 REQ-RA-010 : the second start point times out, the primary continues
+// @goal 15 REQ-RA-007 REQ-RA-009 : a tight section entered during the episode shortens t_max and times out the compensation: stop demand
+// @goal 16 REQ-RA-009 : a tight section entered during the episode shortens t_max, the compensation continues
+// @goal 17 REQ-RA-009 : a steep section entered during the episode raises the margin in force
+// @goal 18 REQ-RA-009 : boundary: the episode keeps a margin above the current section's
+// @goal 19 REQ-RA-009 : boundary: the episode keeps a t_max below the current section's
+// @goal 20 REQ-RA-009 : in TG odometry the limits follow the current section (margin lowered after an episode or a steep section)
+// @goal 21 REQ-RA-013 : IMU failure in TG odometry
+// @goal 22 REQ-RA-013 : IMU failure while compensating: every candidate discarded
+// @goal 23 REQ-RA-013 : IMU failure while stopped after a timeout: the reason becomes the IMU failure
+// @goal 24 REQ-RA-013 : TG failure in TG odometry
+// @goal 25 REQ-RA-013 : TG failure while compensating: every candidate discarded
+// @goal 26 REQ-RA-013 : TG failure while stopped
+// @goal 27 REQ-RA-013 : IMU and TG failing together: the IMU failure is reported
+// @goal 28 REQ-RA-012 : balise in TG odometry: accumulated error reset
+// @goal 29 REQ-RA-012 : balise while compensating: no reset, the compensation continues
+// @goal 30 REQ-RA-007 REQ-RA-012 : balise while stopped after a timeout: position re-established, TG odometry
+// @goal 31 REQ-RA-013 REQ-RA-012 : balise with both sensors healthy again after a sensor failure: position re-established
+// @goal 32 REQ-RA-007 REQ-RA-013 : balise while stopped with a sensor still failing: stop held
+// @goal 33 REQ-RA-007 : stopped without a balise (sensors healthy): stop demand held
+// @goal 34 REQ-RA-007 REQ-RA-010 : the second start point discarded at detection (older than t_max), the primary compensating
+// @goal 35 REQ-RA-007 : every start point older than t_max at detection: stop demand in the detection cycle
+// @goal 36 REQ-RA-010 REQ-RA-006 : one start point: the single candidate adopted [config ONE_START]
+// @goal 37 REQ-RA-007 : one start point: the single candidate times out: stop demand [config ONE_START]
+// @goal 38 REQ-RA-006 REQ-RA-007 : boundary: re-adhesion in the cycle the adopted candidate reaches exactly t_max
+// @goal 39 REQ-RA-006 : a deviation while compensating restarts the confirmation of both start points
+
+#ifdef TRAPS
+#include "readhesion_goals.pml"
+#endif
