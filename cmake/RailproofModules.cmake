@@ -269,22 +269,18 @@ function(railproof_write_targets file)
 endfunction()
 
 # railproof_study(<name> OUTPUTS <first is the result JSON> ... COMMAND ... DEPENDS ... [COMMENT ...])
-#   A pipeline step of the capability's offline analyses (only with RAILPROOF_PIPELINE): its
-#   result feeds the trace and the evidence. Runs in parallel with every other step it does
-#   not depend on.
+#   A pipeline step of the capability's offline analyses: its result feeds the trace and the
+#   evidence. The folder that builds the tool declares it; the pipeline (top-level directory,
+#   where the trace and the evidence can depend on its outputs) adds the build step. It runs
+#   in parallel with every step it does not depend on.
 function(railproof_study name)
   cmake_parse_arguments(A "" "COMMENT" "OUTPUTS;COMMAND;DEPENDS" ${ARGN})
-  if(NOT RAILPROOF_PIPELINE)
-    return()
-  endif()
   if(NOT A_COMMENT)
     set(A_COMMENT "study: ${name}")
   endif()
-  add_custom_command(OUTPUT ${A_OUTPUTS}
-    COMMAND ${CMAKE_COMMAND} -E make_directory ${RAILPROOF_RESULTS_DIR}/analysis
-    COMMAND ${A_COMMAND}
-    DEPENDS ${A_DEPENDS}
-    COMMENT "${A_COMMENT}" VERBATIM)
-  list(GET A_OUTPUTS 0 result)
-  set_property(GLOBAL APPEND PROPERTY RAILPROOF_STUDY_OUTPUTS ${result})
+  set_property(GLOBAL APPEND PROPERTY RAILPROOF_STUDIES ${name})
+  set_property(GLOBAL PROPERTY RAILPROOF_STUDY_${name}_OUTPUTS ${A_OUTPUTS})
+  set_property(GLOBAL PROPERTY RAILPROOF_STUDY_${name}_COMMAND ${A_COMMAND})
+  set_property(GLOBAL PROPERTY RAILPROOF_STUDY_${name}_DEPENDS ${A_DEPENDS})
+  set_property(GLOBAL PROPERTY RAILPROOF_STUDY_${name}_COMMENT "${A_COMMENT}")
 endfunction()

@@ -68,7 +68,32 @@ foreach(cap ${RAILPROOF_CAPABILITIES})
   endif()
 endforeach()
 
-get_property(_study_outputs GLOBAL PROPERTY RAILPROOF_STUDY_OUTPUTS)
+# The studies the offline modules declare (railproof_study): one build step each. Their
+# plots and details go to results/<cap>/ (created here; the tools also create what they need).
+foreach(cap ${RAILPROOF_CAPABILITIES})
+  file(MAKE_DIRECTORY ${RAILPROOF_RESULTS_DIR}/${cap})
+endforeach()
+get_property(_studies GLOBAL PROPERTY RAILPROOF_STUDIES)
+set(_study_outputs)
+foreach(s ${_studies})
+  get_property(_out GLOBAL PROPERTY RAILPROOF_STUDY_${s}_OUTPUTS)
+  get_property(_cmd GLOBAL PROPERTY RAILPROOF_STUDY_${s}_COMMAND)
+  get_property(_dep GLOBAL PROPERTY RAILPROOF_STUDY_${s}_DEPENDS)
+  get_property(_comment GLOBAL PROPERTY RAILPROOF_STUDY_${s}_COMMENT)
+  set(_dirs)
+  foreach(o ${_out})
+    get_filename_component(d ${o} DIRECTORY)
+    list(APPEND _dirs ${d})
+  endforeach()
+  list(REMOVE_DUPLICATES _dirs)
+  add_custom_command(OUTPUT ${_out}
+    COMMAND ${CMAKE_COMMAND} -E make_directory ${_dirs}
+    COMMAND ${_cmd}
+    DEPENDS ${_dep}
+    COMMENT "${_comment}" VERBATIM)
+  list(GET _out 0 _result)
+  list(APPEND _study_outputs ${_result})
+endforeach()
 add_custom_target(railproof_analysis_results ALL DEPENDS ${_proof_outputs} ${_study_outputs})
 
 # ---- checks of the tree itself -----------------------------------------------------------

@@ -187,17 +187,17 @@ def model_bounds(params_pml: Path):
 def generate(model: Path, params_dir: Path, spec_dir: Path, workdir: Path, out_dir: Path,
              walks: int = 50, walk_steps: int = 7000, jobs: int = 2):
     model = Path(model)
-    if model.stem == "moving_block":
-        from . import mb_vectors
+    if model.stem == "mb":
+        from .capabilities import mb as mb_vectors
         return mb_vectors.generate(model, params_dir, spec_dir, workdir, out_dir, walks, jobs)
-    if model.stem == "braking":
-        from . import br_vectors
+    if model.stem == "br":
+        from .capabilities import br as br_vectors
         return br_vectors.generate(model, params_dir, spec_dir, workdir, out_dir, walks, jobs)
-    if model.stem == "readhesion":
-        from . import ra_vectors
+    if model.stem == "ra":
+        from .capabilities import ra as ra_vectors
         return ra_vectors.generate(model, params_dir, spec_dir, workdir, out_dir, walks, jobs)
-    if model.stem == "level_crossing":
-        from . import lc_vectors
+    if model.stem == "lc":
+        from .capabilities import lc as lc_vectors
         return lc_vectors.generate(model, params_dir, spec_dir, workdir, out_dir, walks, jobs)
     model_rel = f"models/{model.name}"
     ann = spin_mod.parse_annotations(model)
@@ -324,7 +324,7 @@ def generate(model: Path, params_dir: Path, spec_dir: Path, workdir: Path, out_d
             **ids},
     }
     def checked(lines, name):
-        return schema_checked_jsonl(Path(spec_dir) / "schemas" / "vectors.schema.json", lines, name)
+        return schema_checked_jsonl(Path(spec_dir) / "schemas" / "vectors_tg.schema.json", lines, name)
 
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)

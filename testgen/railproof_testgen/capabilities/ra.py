@@ -25,11 +25,11 @@ import shutil
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
-from . import __version__
-from . import spin as spin_mod
-from .errors import PipelineError, SpecError
-from .vectors import _progress, load_justifications, search_goal, write_configuration_files, write_goals_file
-from .vectors import model_bounds as _bounds
+from .. import __version__
+from .. import spin as spin_mod
+from ..errors import PipelineError, SpecError
+from ..vectors import _progress, load_justifications, search_goal, write_configuration_files, write_goals_file
+from ..vectors import model_bounds as _bounds
 
 # ra::Mode and ra::StopReason in order, named as their ToString
 MODES = ["TG", "COMPENSATING", "STOPPED"]

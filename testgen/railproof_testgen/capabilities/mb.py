@@ -15,12 +15,12 @@ import shutil
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
-from . import __version__
-from . import spin as spin_mod
-from .errors import PipelineError, SpecError
-from .vectors import _atomic_write, _progress, load_justifications, schema_checked_jsonl, search_goal, \
+from .. import __version__
+from .. import spin as spin_mod
+from ..errors import PipelineError, SpecError
+from ..vectors import _atomic_write, _progress, load_justifications, schema_checked_jsonl, search_goal, \
     write_goals_file
-from .vectors import model_bounds as _bounds
+from ..vectors import model_bounds as _bounds
 
 NOTEL = -9
 KINDS = ["NONE", "PRECEDING_TRAIN", "FIXED_BLOCK", "ROUTE_END", "HANDOVER", "SYSTEM_BOUNDARY",
