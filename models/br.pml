@@ -350,5 +350,5 @@ ltl REQ_BR_003_indication { [] !v_ind }
 // @goal 23 REQ-BR-006 REQ-BR-001 : latched EB held while the emergency pattern is still exceeded
 
 #ifdef TRAPS
-#include "braking_goals.pml"
+#include "br_goals.pml"
 #endif
