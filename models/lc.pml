@@ -1472,5 +1472,5 @@ ltl REQ_LC_010_later { [] !v_later }
 // @goal 100 REQ-LC-009 : boundary: the train departs exactly at t_dep [config GNSS]
 
 #ifdef TRAPS
-#include "level_crossing_goals.pml"
+#include "lc_goals.pml"
 #endif

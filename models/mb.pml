@@ -784,5 +784,5 @@ ltl REQ_MB_018_progress { [] !v_behind }
 // @goal 30 REQ-MB-023 : neighbouring system accepts trains over the boundary [config FEATURE_RADIO]
 
 #ifdef TRAPS
-#include "moving_block_goals.pml"
+#include "mb_goals.pml"
 #endif

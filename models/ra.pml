@@ -635,5 +635,5 @@ ltl REQ_RA_013_sensor { [] !v_sensor }
 // @goal 39 REQ-RA-006 : a deviation while compensating restarts the confirmation of both start points
 
 #ifdef TRAPS
-#include "readhesion_goals.pml"
+#include "ra_goals.pml"
 #endif

@@ -129,7 +129,7 @@ bit g[NGOALS];
 byte gi;
 #define GOAL(x) g[x] = 1
 #define CLEAR_GOALS for (gi : 0 .. NGOALS - 1) { g[gi] = 0 }; gi = 0
-#include "telegram_goals.pml"
+#include "tg_goals.pml"
 #else
 #define GOAL(x) skip
 #define CLEAR_GOALS skip
