@@ -606,7 +606,7 @@ std::int64_t PatternCalculator::PatternSpeed(Pattern pattern, std::int64_t super
   return SpeedAt(q, supervised_front_mm);
 }
 
-// @implements REQ-BR-001 REQ-BR-002 REQ-BR-003 REQ-BR-004 REQ-BR-007 REQ-BR-008 REQ-BR-012
+// @implements REQ-BR-001 REQ-BR-002 REQ-BR-003 REQ-BR-004 REQ-BR-007 REQ-BR-008 REQ-BR-012 REQ-BR-014
 Evaluation PatternCalculator::Evaluate(const PositionEstimate& position,
                                        std::optional<std::int64_t> stop_limit_mm) const noexcept {
   Evaluation out;

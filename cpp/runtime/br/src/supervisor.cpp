@@ -44,7 +44,7 @@ BrakeLevel ServiceLevel(const PatternSpeeds& p, BrakeLevel previous) noexcept {
 
 }  // namespace
 
-// @implements REQ-BR-001 REQ-BR-002 REQ-BR-003 REQ-BR-006
+// @implements REQ-BR-001 REQ-BR-002 REQ-BR-003 REQ-BR-006 REQ-BR-014
 Decision Supervisor::Step(const PatternSpeeds& p, const DriverInputs& in) noexcept {
   Decision d;
   if (latched_) {
