@@ -6,11 +6,16 @@ set(RAILPROOF_GEN_INCLUDE ${RAILPROOF_GEN_DIR}/include)
 file(MAKE_DIRECTORY ${RAILPROOF_GEN_INCLUDE}/railproof/generated ${RAILPROOF_GEN_DIR}/models)
 file(GLOB RAILPROOF_SPEC_FILES CONFIGURE_DEPENDS
   ${RAILPROOF_SOURCE_DIR}/spec/*.yaml ${RAILPROOF_SOURCE_DIR}/spec/*/*.yaml ${RAILPROOF_SOURCE_DIR}/spec/schemas/*.json)
+# The hand-written JSON data of the simulators (spec/scenarios, spec/wheelrail): checked by
+# the same validation (schema, then what the schema cannot say), so a bad file fails the
+# build naming file, entry and reason; only the validating step depends on them.
+file(GLOB RAILPROOF_SPEC_DATA_FILES CONFIGURE_DEPENDS
+  ${RAILPROOF_SOURCE_DIR}/spec/scenarios/*.json ${RAILPROOF_SOURCE_DIR}/spec/wheelrail/*.json)
 # The spec steps depend on the testgen modules they run, not on all of testgen: a change to
 # the evidence code does not regenerate the parameter headers (and re-verify every model).
 set(_tgm ${RAILPROOF_SOURCE_DIR}/testgen/railproof_testgen)
 set(RAILPROOF_SPEC_TOOL_FILES ${_tgm}/__init__.py ${_tgm}/__main__.py ${_tgm}/errors.py ${_tgm}/spec.py
-    ${_tgm}/validate.py ${_tgm}/lines.py ${_tgm}/trains.py ${_tgm}/params.py)
+    ${_tgm}/validate.py ${_tgm}/lines.py ${_tgm}/trains.py ${_tgm}/timetables.py ${_tgm}/params.py)
 # One C++ header and one Promela header per parameter file, named after the file
 # (spec/parameters/<name>.yaml -> <name>_params.hpp / .pml; gen-params checks the name).
 file(GLOB RAILPROOF_PARAM_FILES CONFIGURE_DEPENDS ${RAILPROOF_SOURCE_DIR}/spec/parameters/*.yaml)
@@ -24,7 +29,7 @@ endforeach()
 add_custom_command(
   OUTPUT ${RAILPROOF_PARAM_HEADER} ${RAILPROOF_PARAM_PML}
   COMMAND ${RAILPROOF_TESTGEN} gen-params --spec ${RAILPROOF_SOURCE_DIR}/spec --out ${RAILPROOF_GEN_DIR}
-  DEPENDS ${RAILPROOF_SPEC_FILES} ${RAILPROOF_SPEC_TOOL_FILES}
+  DEPENDS ${RAILPROOF_SPEC_FILES} ${RAILPROOF_SPEC_DATA_FILES} ${RAILPROOF_SPEC_TOOL_FILES}
   COMMENT "spec: validating spec/ and generating parameter headers"
   VERBATIM)
 add_custom_target(railproof_gen_params DEPENDS ${RAILPROOF_PARAM_HEADER} ${RAILPROOF_PARAM_PML})
@@ -67,3 +72,20 @@ add_custom_command(
   COMMENT "spec: validating spec/trains and writing the train JSON"
   VERBATIM)
 add_custom_target(railproof_gen_trains ALL DEPENDS ${RAILPROOF_TRAIN_JSON} ${RAILPROOF_TRAIN_MUTANT_JSON})
+
+# Timetables (spec/timetables/*.yaml): validated (schema, then the stations, running lines,
+# train types, dwells, platforms and departure order against spec/lines and spec/trains) and
+# converted to the JSON read by the level-crossing warning-time study (build/gen/timetables).
+file(GLOB RAILPROOF_TIMETABLE_FILES CONFIGURE_DEPENDS ${RAILPROOF_SOURCE_DIR}/spec/timetables/*.yaml)
+set(RAILPROOF_TIMETABLE_JSON)
+foreach(f ${RAILPROOF_TIMETABLE_FILES})
+  get_filename_component(n ${f} NAME_WE)
+  list(APPEND RAILPROOF_TIMETABLE_JSON ${RAILPROOF_GEN_DIR}/timetables/${n}.json)
+endforeach()
+add_custom_command(
+  OUTPUT ${RAILPROOF_TIMETABLE_JSON}
+  COMMAND ${RAILPROOF_TESTGEN} timetables --spec ${RAILPROOF_SOURCE_DIR}/spec --out ${RAILPROOF_GEN_DIR}/timetables
+  DEPENDS ${RAILPROOF_TIMETABLE_FILES} ${RAILPROOF_SPEC_FILES} ${RAILPROOF_SPEC_TOOL_FILES}
+  COMMENT "spec: validating spec/timetables and writing the timetable JSON"
+  VERBATIM)
+add_custom_target(railproof_gen_timetables ALL DEPENDS ${RAILPROOF_TIMETABLE_JSON})

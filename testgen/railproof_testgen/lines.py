@@ -53,14 +53,13 @@ Rules after the schema (entry names such as ``balises[B7]`` or ``gradients[3]``)
 """
 from __future__ import annotations
 
-import json
-import sys
 from decimal import Decimal, InvalidOperation
 from pathlib import Path
 
 from . import spec as spec_mod
 from . import validate as vmod
 from .errors import SpecError
+from .validate import label as _label
 
 SUB = "lines"
 SCHEMA_FILE = "line.schema.json"
@@ -82,49 +81,6 @@ def _m(mm):
 
 def _sec(a, b):
     return f"[{_m(a)}, {_m(b)}) m"
-
-
-def _label(section, item, index):
-    if isinstance(item, dict):
-        for key in ("id", "name"):
-            v = item.get(key)
-            if isinstance(v, (str, int)) and not isinstance(v, bool) and v != "":
-                return f"{section}[{v}]"
-    return f"{section}[{index}]"
-
-
-def _schema_entry(data, path):
-    """(entry, where) for a schema error at `path` inside `data`."""
-    if not path:
-        return "-", ""
-    entry, node, rest = [], data, list(path)
-    consumed = 0
-    i = 0
-    while i < len(rest):
-        key = rest[i]
-        nxt = rest[i + 1] if i + 1 < len(rest) else None
-        if isinstance(key, str) and isinstance(nxt, int) and isinstance(node, dict) \
-                and isinstance(node.get(key), list):
-            lst = node[key]
-            item = lst[nxt] if nxt < len(lst) else None
-            entry.append(_label(key, item, nxt))
-            node = item
-            i += 2
-            consumed = i
-            continue
-        break
-    if not entry:
-        return str(rest[0]), ".".join(str(p) for p in rest[1:])
-    return ".".join(entry), ".".join(str(p) for p in rest[consumed:])
-
-
-def _schema_errors(validator, data, file, report):
-    n = 0
-    for err in sorted(validator.iter_errors(data), key=lambda e: [str(p) for p in e.path]):
-        entry, where = _schema_entry(data, list(err.path))
-        report.error(file, entry, f"{where}: {err.message}" if where else err.message)
-        n += 1
-    return n
 
 
 def _int_parameter(spec_dir, area, pid):
@@ -815,69 +771,17 @@ def check_lines(spec_dir, report):
         return outputs, refs
     for bad in sorted(lines_dir.glob("*.yml")):
         report.error(bad, "-", "use the .yaml extension (files named *.yml are not read)")
-    files = line_files(spec_dir)
-    if not files:
-        return outputs, refs
-    try:
-        validator = vmod._load_schema(spec_dir, SCHEMA_FILE)
-    except SpecError as exc:
-        report.error(exc.file, exc.entry, exc.reason)
-        return outputs, refs
     max_blocks = _max_blocks(spec_dir)
     lc_limits = _CrossingLimits.from_spec(spec_dir)
-    for f in files:
-        try:
-            data = spec_mod.load_yaml(f)
-        except SpecError as exc:
-            report.error(exc.file, exc.entry, exc.reason)
-            continue
-        if _schema_errors(validator, data, f, report):
-            continue
-        name = data["name"]
-        refs.append((f, name, "assumption", data["assumption"]))
-        refs.extend((f, name, f"source[{i}]", s) for i, s in enumerate(data["source"]))
+
+    def check(f, data):
+        refs.extend(vmod.provenance_refs(f, data["name"], data))
         obj = _Line(f, data, report, max_blocks, lc_limits).check()
         if obj is not None:
-            outputs[name] = obj
+            outputs[data["name"]] = obj
+
+    vmod.check_data_files(spec_dir, line_files(spec_dir), SCHEMA_FILE, report, check)
     return outputs, refs
-
-
-def _known_assumptions(spec_dir, report):
-    ids = set()
-    for f in spec_mod.spec_files(spec_dir, "assumptions"):
-        try:
-            data = spec_mod.load_yaml(f)
-        except SpecError as exc:
-            report.error(exc.file, exc.entry, exc.reason)
-            return None
-        for e in data.get("assumptions") or []:
-            if isinstance(e, dict) and isinstance(e.get("id"), str):
-                ids.add(e["id"])
-    return ids
-
-
-def check_refs(refs, known, report):
-    """Every ASM-NNN named by a line file must exist."""
-    for f, entry, where, s in refs:
-        for token in vmod.ID_TOKEN.findall(s):
-            if token.startswith("ASM-") and vmod.ASM_ID.match(token) and token not in known:
-                report.error(f, entry, f"{where}: unknown assumption {token}")
-            elif token.startswith("ASM-") and not vmod.ASM_ID.match(token):
-                report.error(f, entry, f"{where}: malformed reference {token!r}")
-
-
-def render(obj):
-    """Deterministic JSON text of one line (sorted keys, fixed indentation)."""
-    return json.dumps(obj, sort_keys=True, indent=1, ensure_ascii=False) + "\n"
-
-
-def _write(path: Path, text: str):
-    path.parent.mkdir(parents=True, exist_ok=True)
-    if path.exists() and path.read_text(encoding="utf-8") == text:
-        return
-    tmp = path.with_name(path.name + ".tmp")
-    tmp.write_text(text, encoding="utf-8")
-    tmp.replace(path)  # atomic: a reader never sees a half-written file
 
 
 def build(spec_dir):
@@ -890,9 +794,9 @@ def build(spec_dir):
     outputs, refs = check_lines(spec_dir, report)
     if not line_files(spec_dir) and not report.errors:
         report.error(spec_dir / SUB, "-", "no line files (*.yaml)")
-    known = _known_assumptions(spec_dir, report)
+    known = vmod.known_assumptions(spec_dir, report)
     if known is not None:
-        check_refs(refs, known, report)
+        vmod.check_assumption_refs(refs, known, report)
     return outputs, report
 
 
@@ -900,25 +804,19 @@ def generate(spec_dir, out_dir):
     """Validate spec/lines and write OUT/<name>.json; raises SpecError (first error, with
     the count of the others) and writes nothing if any line file is invalid."""
     outputs, report = build(spec_dir)
-    if report.errors:
-        first, more = report.errors[0], len(report.errors) - 1
-        raise SpecError(first.file, first.entry,
-                        first.reason + (f" (and {more} more)" if more else ""))
+    vmod.raise_first(report)
     for name, obj in sorted(outputs.items()):
-        _write(Path(out_dir) / f"{name}.json", render(obj))
+        spec_mod.write_atomic(Path(out_dir) / f"{name}.json", spec_mod.render_json(obj))
     return sorted(outputs)
 
 
 def run(args):
     spec_dir, out_dir = Path(args.spec), Path(args.out)
     outputs, report = build(spec_dir)
-    report.print()
-    if report.errors:
-        print(f"lines: {len(report.errors)} error(s) in {spec_dir / SUB}; nothing written",
-              file=sys.stderr)
+    if vmod.failed(report, "lines", spec_dir / SUB):
         return 1
     for name, obj in sorted(outputs.items()):
-        _write(out_dir / f"{name}.json", render(obj))
+        spec_mod.write_atomic(out_dir / f"{name}.json", spec_mod.render_json(obj))
         rls = obj["running_lines"]
         print(f"lines: {name}: {len(rls)} running line(s) "
               f"({', '.join(r['id'] for r in rls)}), {_m(rls[0]['length_mm'])} m, "
