@@ -309,16 +309,17 @@ def _check_file_name(report, f, data):
         report.error(f, "name", f"{data['name']!r} must equal the file name {f.stem!r}")
 
 
-def check_scenarios(spec_dir, report, lines):
-    """spec/scenarios/*.json (line_sim): the schema, then what it cannot say: the name is
-    the file name, the line is a valid line of spec/lines with the running line, every stop
+def check_scenarios(spec_dir, report, lines, files=None):
+    """spec/scenarios/*.json (line_sim), or the given files: the schema, then what it
+    cannot say: the name is the file name (of spec/scenarios), the line is a valid line of spec/lines with the running line, every stop
     names a station of that running line, and a siding request names a route of it (none
     named: the running line has a reverse, non-automatic route). The rules within the file
     (ordering, windows, train ids) are the simulator's (spec/design/data.md)."""
-    out = {}
+    out, own = {}, files is None
 
     def check(f, data):
-        _check_file_name(report, f, data)
+        if own:
+            _check_file_name(report, f, data)
         line = lines.get(data["line"])
         if line is None:
             report.error(f, "line", missing_data(spec_dir, "lines", data["line"], "line"))
@@ -348,27 +349,56 @@ def check_scenarios(spec_dir, report, lines):
                                                 "(reverse, non-automatic) route")
         out[data["name"]] = data
 
-    check_data_files(spec_dir, sorted((Path(spec_dir) / "scenarios").glob("*.json")),
-                     "scenario.schema.json", report, check, load=spec_mod.load_json)
+    if own:
+        files = sorted((Path(spec_dir) / "scenarios").glob("*.json"))
+    check_data_files(spec_dir, files, "scenario.schema.json", report, check,
+                     load=spec_mod.load_json)
     return out
 
 
-def check_wheelrail(spec_dir, report):
-    """spec/wheelrail/*.json (wheelrail_sim, odometry_study): the schema, then what it cannot
-    say: the name is the file name and every requirement named exists (returned as
+def check_wheelrail(spec_dir, report, files=None):
+    """spec/wheelrail/*.json (wheelrail_sim, odometry_study), or the given files: the
+    schema, then what it cannot say: the name is the file name (of spec/wheelrail) and
+    every requirement named exists (returned as
     references for the caller's check). The rules within the file (ordering, the vertical
     curves fitting, the car inside the alignment) are the simulator's."""
-    out, refs = {}, []
+    out, refs, own = {}, [], files is None
 
     def check(f, data):
-        _check_file_name(report, f, data)
+        if own:
+            _check_file_name(report, f, data)
         refs.extend((f, data["name"], f"requirements[{i}]", r)
                     for i, r in enumerate(data["requirements"]))
         out[data["name"]] = data
 
-    check_data_files(spec_dir, sorted((Path(spec_dir) / "wheelrail").glob("*.json")),
-                     "wheelrail_scenario.schema.json", report, check, load=spec_mod.load_json)
+    if own:
+        files = sorted((Path(spec_dir) / "wheelrail").glob("*.json"))
+    check_data_files(spec_dir, files, "wheelrail_scenario.schema.json", report, check,
+                     load=spec_mod.load_json)
     return out, refs
+
+
+# The hand-written data files that `validate --data FILE` checks, by the schema they name.
+_DATA_CHECKS = {"railproof/scenario/1": "scenarios", "railproof/wheelrail-scenario/1": "wheelrail"}
+
+
+def _check_data_args(spec_dir, paths, model, refs, report):
+    """Files given on the command line (a scenario written by hand for line_sim or
+    wheelrail_sim): the same checks as the spec's own, but for the file name."""
+    for path in map(Path, paths):
+        try:
+            kind = _DATA_CHECKS.get(spec_mod.load_json(path).get("schema"))
+        except SpecError as exc:
+            report.error(exc.file, exc.entry, exc.reason)
+            continue
+        if kind is None:
+            report.error(path, "schema", "not one of " + ", ".join(sorted(_DATA_CHECKS)))
+        elif kind == "scenarios":
+            model[kind].update(check_scenarios(spec_dir, report, model["lines"], [path]))
+        else:
+            out, more = check_wheelrail(spec_dir, report, [path])
+            model[kind].update(out)
+            refs.extend(more)
 
 
 def _strings(obj, where=""):
@@ -394,9 +424,10 @@ def _list_files(spec_dir: Path, sub: str, report: Report):
     return spec_mod.spec_files(spec_dir, sub)
 
 
-def check_spec(spec_dir):
-    """Check spec_dir completely. Returns (model, report); model is built from the
-    entries that could be read even when the report has errors."""
+def check_spec(spec_dir, data_files=()):
+    """Check spec_dir completely, and the data files `data_files` (paths) against it. Returns
+    (model, report); model is built from the entries that could be read even when the
+    report has errors."""
     spec_dir = Path(spec_dir)
     report = Report()
     if not spec_dir.is_dir():
@@ -471,6 +502,7 @@ def check_spec(spec_dir):
     model["scenarios"] = check_scenarios(spec_dir, report, model["lines"])
     model["wheelrail"], wr_refs = check_wheelrail(spec_dir, report)
     refs.extend(wr_refs)
+    _check_data_args(spec_dir, data_files, model, refs, report)
 
     _check_references(model, refs, report)
     _check_requirements(model, report)
@@ -584,7 +616,7 @@ def validate_spec(spec_dir):
 
 
 def run(args):
-    model, report = check_spec(Path(args.spec))
+    model, report = check_spec(Path(args.spec), args.data)
     report.print()
     n = {k: len(v) for k, v in model.items()}
     if report.errors:
@@ -610,4 +642,8 @@ def register(sub):
                     "the others. Prints every finding as 'file: entry: reason'; exit 1 on "
                     "any error.")
     p.add_argument("--spec", required=True, help="spec/ directory")
+    p.add_argument("--data", action="append", default=[], metavar="FILE",
+                   help="also check this scenario or wheel-rail scenario JSON (for example "
+                        "one written by hand for line_sim or wheelrail_sim) against the "
+                        "spec; repeatable")
     p.set_defaults(func=run)
