@@ -34,21 +34,29 @@ add_custom_command(
   VERBATIM)
 add_custom_target(railproof_gen_params DEPENDS ${RAILPROOF_PARAM_HEADER} ${RAILPROOF_PARAM_PML})
 
+# A converted kind of data (spec/<kind>/*.yaml -> build/gen/<kind>/<name>.json by
+# `railproof_testgen <kind>`, which validates first and writes nothing on an error): sets
+# RAILPROOF_<VAR>_JSON (the outputs) and the target railproof_gen_<kind>.
+function(railproof_spec_data kind var comment)
+  file(GLOB _files CONFIGURE_DEPENDS ${RAILPROOF_SOURCE_DIR}/spec/${kind}/*.yaml)
+  set(_json)
+  foreach(f ${_files})
+    get_filename_component(n ${f} NAME_WE)
+    list(APPEND _json ${RAILPROOF_GEN_DIR}/${kind}/${n}.json)
+  endforeach()
+  add_custom_command(
+    OUTPUT ${_json}
+    COMMAND ${RAILPROOF_TESTGEN} ${kind} --spec ${RAILPROOF_SOURCE_DIR}/spec --out ${RAILPROOF_GEN_DIR}/${kind}
+    DEPENDS ${_files} ${RAILPROOF_SPEC_FILES} ${RAILPROOF_SPEC_TOOL_FILES}
+    COMMENT "spec: ${comment}"
+    VERBATIM)
+  add_custom_target(railproof_gen_${kind} ALL DEPENDS ${_json})
+  set(RAILPROOF_${var}_JSON ${_json} PARENT_SCOPE)
+endfunction()
+
 # Line data (spec/lines/*.yaml): validated (schema + topology rules, errors name the file
 # and entry) and converted to the JSON the C++ line simulator reads (build/gen/lines).
-file(GLOB RAILPROOF_LINE_FILES CONFIGURE_DEPENDS ${RAILPROOF_SOURCE_DIR}/spec/lines/*.yaml)
-set(RAILPROOF_LINE_JSON)
-foreach(f ${RAILPROOF_LINE_FILES})
-  get_filename_component(n ${f} NAME_WE)
-  list(APPEND RAILPROOF_LINE_JSON ${RAILPROOF_GEN_DIR}/lines/${n}.json)
-endforeach()
-add_custom_command(
-  OUTPUT ${RAILPROOF_LINE_JSON}
-  COMMAND ${RAILPROOF_TESTGEN} lines --spec ${RAILPROOF_SOURCE_DIR}/spec --out ${RAILPROOF_GEN_DIR}/lines
-  DEPENDS ${RAILPROOF_LINE_FILES} ${RAILPROOF_SPEC_FILES} ${RAILPROOF_SPEC_TOOL_FILES}
-  COMMENT "spec: validating spec/lines and writing the line JSON"
-  VERBATIM)
-add_custom_target(railproof_gen_lines ALL DEPENDS ${RAILPROOF_LINE_JSON})
+railproof_spec_data(lines LINE "validating spec/lines and writing the line JSON")
 
 # Train types (spec/trains/*.yaml and the negative-test types of spec/trains/mutants):
 # validated (schema, ranges, design rule REQ-BR-010) and converted to the JSON read by the
@@ -76,16 +84,4 @@ add_custom_target(railproof_gen_trains ALL DEPENDS ${RAILPROOF_TRAIN_JSON} ${RAI
 # Timetables (spec/timetables/*.yaml): validated (schema, then the stations, running lines,
 # train types, dwells, platforms and departure order against spec/lines and spec/trains) and
 # converted to the JSON read by the level-crossing warning-time study (build/gen/timetables).
-file(GLOB RAILPROOF_TIMETABLE_FILES CONFIGURE_DEPENDS ${RAILPROOF_SOURCE_DIR}/spec/timetables/*.yaml)
-set(RAILPROOF_TIMETABLE_JSON)
-foreach(f ${RAILPROOF_TIMETABLE_FILES})
-  get_filename_component(n ${f} NAME_WE)
-  list(APPEND RAILPROOF_TIMETABLE_JSON ${RAILPROOF_GEN_DIR}/timetables/${n}.json)
-endforeach()
-add_custom_command(
-  OUTPUT ${RAILPROOF_TIMETABLE_JSON}
-  COMMAND ${RAILPROOF_TESTGEN} timetables --spec ${RAILPROOF_SOURCE_DIR}/spec --out ${RAILPROOF_GEN_DIR}/timetables
-  DEPENDS ${RAILPROOF_TIMETABLE_FILES} ${RAILPROOF_SPEC_FILES} ${RAILPROOF_SPEC_TOOL_FILES}
-  COMMENT "spec: validating spec/timetables and writing the timetable JSON"
-  VERBATIM)
-add_custom_target(railproof_gen_timetables ALL DEPENDS ${RAILPROOF_TIMETABLE_JSON})
+railproof_spec_data(timetables TIMETABLE "validating spec/timetables and writing the timetable JSON")

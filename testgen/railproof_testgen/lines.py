@@ -858,9 +858,7 @@ def build(spec_dir):
     outputs, refs = check_lines(spec_dir, report)
     if not line_files(spec_dir) and not report.errors:
         report.error(spec_dir / SUB, "-", "no line files (*.yaml)")
-    known = vmod.known_assumptions(spec_dir, report)
-    if known is not None:
-        vmod.check_assumption_refs(refs, known, report)
+    vmod.check_assumption_refs(spec_dir, refs, report)
     return outputs, report
 
 

@@ -275,9 +275,7 @@ def build(spec_dir):
     trains, _ = trains_mod.check_trains(spec_dir, others)
     outputs, refs = check_timetables(spec_dir, report, lines,
                                      {n: t for (m, n), t in trains.items() if not m})
-    known = vmod.known_assumptions(spec_dir, report)
-    if known is not None:
-        vmod.check_assumption_refs(refs, known, report)
+    vmod.check_assumption_refs(spec_dir, refs, report)
     return outputs, report
 
 

@@ -108,9 +108,7 @@ def build(spec_dir):
     outputs, refs = check_trains(spec_dir, report, with_mutants=True)
     if not any(not m for m, _ in outputs) and not report.errors:
         report.error(spec_dir / SUB, "-", "no train type files (*.yaml)")
-    known = vmod.known_assumptions(spec_dir, report)
-    if known is not None:
-        vmod.check_assumption_refs(refs, known, report)
+    vmod.check_assumption_refs(spec_dir, refs, report)
     return outputs, report
 
 

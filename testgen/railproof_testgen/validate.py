@@ -153,10 +153,12 @@ def _entry_name(data, path):
     return str(head), ".".join(str(p) for p in path[1:])
 
 
-def _schema_errors(validator, data, file, report):
+def _schema_errors(validator, data, file, report, entry_of=_entry_name):
+    """Report every schema error as ``file: entry: where: message`` (the entry named by
+    entry_of(data, path)); returns their number."""
     n = 0
     for err in sorted(validator.iter_errors(data), key=lambda e: [str(p) for p in e.path]):
-        entry, where = _entry_name(data, list(err.path))
+        entry, where = entry_of(data, list(err.path))
         report.error(file, entry, f"{where}: {err.message}" if where else err.message)
         n += 1
     return n
@@ -199,14 +201,9 @@ def _schema_entry(data, path):
 
 
 def data_schema_errors(validator, data, file, report):
-    """Report every schema error of a data file (lines, trains, timetables, scenarios) as
-    ``file: entry: where: message``; returns their number."""
-    n = 0
-    for err in sorted(validator.iter_errors(data), key=lambda e: [str(p) for p in e.path]):
-        entry, where = _schema_entry(data, list(err.path))
-        report.error(file, entry, f"{where}: {err.message}" if where else err.message)
-        n += 1
-    return n
+    """The schema errors of a data file (lines, trains, timetables, scenarios), entries
+    named by label()."""
+    return _schema_errors(validator, data, file, report, _schema_entry)
 
 
 def check_data_files(spec_dir, files, schema_name, report, check, load=spec_mod.load_yaml):
@@ -266,9 +263,13 @@ def known_assumptions(spec_dir, report):
     return ids
 
 
-def check_assumption_refs(refs, known, report):
-    """Every ASM-NNN named by a data file must exist (used by the single-kind commands
-    lines, trains and timetables; validate checks every kind of reference)."""
+def check_assumption_refs(spec_dir, refs, report):
+    """Every ASM-NNN named by a data file must exist in spec/assumptions (used by the
+    single-kind commands lines, trains and timetables; validate checks every kind of
+    reference)."""
+    known = known_assumptions(spec_dir, report)
+    if known is None:
+        return
     for f, entry, where, s in refs:
         for token in ID_TOKEN.findall(s):
             if token.startswith("ASM-") and ASM_ID.match(token) and token not in known:
