@@ -12,7 +12,7 @@ import sys
 from .errors import PipelineError, SpecError
 
 COMMAND_MODULES = ["registry", "layout", "params", "validate", "lines", "trace", "spin", "vectors", "evidence",
-                   "toolversions", "trains", "proofs"]
+                   "toolversions", "trains", "timetables", "proofs"]
 
 
 def build_parser():
