@@ -11,10 +11,12 @@
 #               the rendered evidence package in ${CMAKE_BINARY_DIR}/evidence.
 set(RAILPROOF_VECTOR_DIR ${RAILPROOF_RESULTS_DIR}/vectors)
 set(_tg ${RAILPROOF_SOURCE_DIR}/testgen/railproof_testgen)
-# what every testgen command runs (the command line and its error types)
-set(_tg_base ${_tg}/__init__.py ${_tg}/__main__.py ${_tg}/errors.py ${_tg}/spec.py)
+# what every testgen command runs (the command line and its error types); each step adds the
+# modules it runs (the command line imports only the module of the command)
+set(_tg_base ${_tg}/__init__.py ${_tg}/__main__.py ${_tg}/errors.py)
 set(_tg_spin ${_tg_base} ${_tg}/spin.py)
 file(GLOB _tg_engine CONFIGURE_DEPENDS ${_tg}/vectorgen.py ${_tg}/vectors.py)
+list(APPEND _tg_engine ${_tg}/spec.py ${_tg}/registry.py ${_tg}/capabilities/__init__.py)
 
 # SPIN and vector generation are memory- and CPU-heavy: at most two at a time (each runs its
 # own searches on two worker threads).
@@ -62,7 +64,8 @@ foreach(cap ${RAILPROOF_CAPABILITIES})
       OUTPUT ${_proofs}
       COMMAND ${RAILPROOF_TESTGEN} proofs --spec ${RAILPROOF_SOURCE_DIR}/spec
               --proofs ${RAILPROOF_SOURCE_DIR}/proofs --out ${RAILPROOF_RESULTS_DIR}/proofs
-      DEPENDS ${_cap_proofs} ${RAILPROOF_PARAM_FILES} ${RAILPROOF_TRAIN_FILES} ${_tg_base} ${_tg}/proofs.py
+      DEPENDS ${_cap_proofs} ${RAILPROOF_PARAM_FILES} ${RAILPROOF_TRAIN_FILES} ${_tg_base} ${_tg}/spec.py
+              ${_tg}/proofs.py
       COMMENT "proofs: SMT obligations of proofs/${cap} from spec/, replayed by z3 and cvc5" VERBATIM)
     list(APPEND _proof_outputs ${_proofs})
   endif()
@@ -153,7 +156,8 @@ add_custom_command(
   COMMAND ${RAILPROOF_TESTGEN} trace --spec ${RAILPROOF_SOURCE_DIR}/spec --src ${RAILPROOF_SOURCE_DIR}
           --results ${RAILPROOF_RESULTS_DIR} --out ${_trace}
   DEPENDS ${_spin_outputs} ${_vector_outputs} ${_proof_outputs} ${_study_outputs} ${_traced_sources}
-          ${_proof_sources} ${RAILPROOF_SPEC_FILES} ${_tg_base} ${_tg}/trace.py ${_tg}/registry.py
+          ${_proof_sources} ${RAILPROOF_SPEC_FILES} ${RAILPROOF_SPEC_TOOL_FILES} ${_tg}/trace.py
+          ${_tg}/registry.py
   COMMENT "trace: requirement <-> property/vector/code/test links" VERBATIM)
 add_custom_target(railproof_trace ALL DEPENDS ${_trace})
 
