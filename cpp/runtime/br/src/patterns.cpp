@@ -30,7 +30,8 @@
 //
 // Seeded faults (negative tests, cpp/runtime/br/tests/test_patterns.cpp kills each one):
 // FAULT_BR_NO_FREE_RUNNING, FAULT_BR_GRADIENT_FRONT_ONLY, FAULT_BR_RESTRICTION_FRONT_RELEASE,
-// FAULT_BR_NO_SPEED_ALLOWANCE. Never defined in the railproof_braking library.
+// FAULT_BR_NO_SPEED_ALLOWANCE; active only in the test-only schemata variant
+// (spec/design/seeded-faults.md).
 #include "railproof/core/seeded_fault.hpp"
 #include "railproof/br/patterns.hpp"
 

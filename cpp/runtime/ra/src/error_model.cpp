@@ -3,7 +3,7 @@
 //
 // Seeded fault (negative test, cpp/runtime/ra/tests/test_odometry.cpp kills it):
 //   FAULT_RA_NO_GRADIENT_TERM   Delta_a without the gradient term Delta_a_g
-// Never defined in the railproof_odometry library.
+// Active only in the test-only schemata variant (spec/design/seeded-faults.md).
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
