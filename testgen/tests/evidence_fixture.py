@@ -67,6 +67,13 @@ def context(spec=SPEC, results=RESULTS, repo=None, tmp=None):
     return evidence.context(spec, results, repo or repo_copy(tmp))
 
 
+def assert_fails(ctx, *problems: str) -> None:
+    """The verdict is FAIL and every problem is among its reasons (word for word)."""
+    assert ctx.verdict == "FAIL"
+    missing = [p for p in problems if p not in ctx.problems]
+    assert not missing, (missing, ctx.problems)
+
+
 def text_of(html: str) -> str:
     return " ".join(html_mod.unescape(re.sub(r"<[^>]+>", " ", html)).split())
 

@@ -7,16 +7,15 @@
 from __future__ import annotations
 
 import hashlib
+import platform
 import re
-import sys
-from importlib import metadata
 from pathlib import Path
 
 from ..errors import PipelineError
+from ..toolversions import DOC_PACKAGES, package_versions
 from . import analysis, boundaries, chapters, generation, modelcheck, tests
 from .text import fmt_value, need_id
 
-DOC_TOOLS = ("Sphinx", "sphinx-needs", "sphinx-test-reports", "docutils", "Jinja2", "PyYAML")
 _ASM = re.compile(r"ASM(?:-[A-Z]+)?-\d+")
 
 
@@ -190,12 +189,8 @@ class Context:
         if self.inp.tool_versions is not None:
             flat("", self.inp.tool_versions)
         self.spin_versions = [(m["model"], m["spin_version"]) for m in self.models]
-        self.doc_versions = [("Python", ".".join(map(str, sys.version_info[:3])))]
-        for dist in DOC_TOOLS:
-            try:
-                self.doc_versions.append((dist, metadata.version(dist)))
-            except metadata.PackageNotFoundError:
-                self.doc_versions.append((dist, "not installed"))
+        self.doc_versions = [("Python", platform.python_version())] + list(
+            package_versions(DOC_PACKAGES).items())
         gens = sorted({fmt_value(h.get("generator")) for _, h, _ in self.inp.vectors if h.get("generator")})
         self.generator_versions = [("vector generator", g) for g in gens]
 

@@ -63,6 +63,7 @@ class Inputs:
     layout: dict | None = None
     tool_versions: dict | None = None
     model_copies: dict = field(default_factory=dict)  # model path -> its copy under inputs/
+    _rels: set = field(default_factory=set)
     extra: dict = field(default_factory=dict)         # what chapter modules load (by capability)
     files: list = field(default_factory=list)         # [InputFile]
     missing: list = field(default_factory=list)       # result files the build did not write
@@ -70,7 +71,8 @@ class Inputs:
     def add(self, path: Path, rel: str | None = None) -> str:
         """Record a file as an input of the package (once); returns its path under results/."""
         rel = rel or f"results/{path.relative_to(self.results_dir).as_posix()}"
-        if all(f.rel != rel for f in self.files):
+        if rel not in self._rels:
+            self._rels.add(rel)
             self.files.append(InputFile(path, rel))
         return rel.removeprefix("results/")
 
@@ -103,6 +105,16 @@ def _json_object(path: Path, what: str, schema: str | None = None) -> dict:
     if schema:
         require(data.get("schema") == schema, path, "schema", f"expected {schema!r}, got {data.get('schema')!r}")
     return data
+
+
+def _required(inp: Inputs, rel: str, what: str, schema: str, writer: str) -> tuple:
+    """(path, object) of results/<rel>, which the evidence cannot do without."""
+    path = inp.results_dir / rel
+    if not path.is_file():
+        raise PipelineError(f"{path}: {rel} not found ({writer})")
+    data = _json_object(path, what, schema)
+    inp.add(path)
+    return path, data
 
 
 def _optional(inp: Inputs, rel: str, what: str, schema: str | None = None):
@@ -171,11 +183,8 @@ def load_design_notes(inp: Inputs) -> None:
 
 
 def load_registry(inp: Inputs) -> None:
-    path = inp.results_dir / "registry.json"
-    if not path.is_file():
-        raise PipelineError(f"{path}: registry.json not found (the build writes it from "
-                            "spec/capabilities.yaml; the chapters are driven by it)")
-    data = _json_object(path, "registry", REGISTRY_SCHEMA)
+    path, data = _required(inp, "registry.json", "registry", REGISTRY_SCHEMA,
+                           "the build writes it from spec/capabilities.yaml; the chapters are driven by it")
     caps = data.get("capabilities")
     require(isinstance(caps, list) and caps, path, "capabilities", "must be a non-empty list")
     for i, c in enumerate(caps):
@@ -186,22 +195,17 @@ def load_registry(inp: Inputs) -> None:
         for key in ("title", "design", "chapter"):
             require(isinstance(c.get(key), str), path, c["name"], f"'{key}' must be a string")
     inp.registry = caps
-    inp.add(path)
 
 
 def load_trace(inp: Inputs) -> None:
-    path = inp.results_dir / "trace.json"
-    if not path.is_file():
-        raise PipelineError(f"{path}: trace.json not found (the traceability step writes it; "
-                            "run it before rendering the evidence)")
-    data = _json_object(path, "trace.json", TRACE_SCHEMA)
+    path, data = _required(inp, "trace.json", "trace.json", TRACE_SCHEMA,
+                           "the traceability step writes it; run it before rendering the evidence")
     reqs = data.get("requirements")
     require(isinstance(reqs, list), path, "requirements", "must be a list")
     for i, r in enumerate(reqs):
         require(isinstance(r, dict) and "id" in r, path, f"requirements[{i}]", "needs an 'id'")
         require(isinstance(r.get("links", {}), dict), path, r["id"], "'links' must be an object")
     inp.trace = data
-    inp.add(path)
 
 
 def _entries(path: Path, data: dict, key: str, needs: tuple) -> None:
