@@ -31,7 +31,6 @@ from __future__ import annotations
 import importlib
 from collections import Counter
 from fnmatch import fnmatch
-from pathlib import Path
 
 
 def module(name: str):
