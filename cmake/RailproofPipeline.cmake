@@ -8,7 +8,8 @@
 #               with goal coverage; per capability with proofs: the SMT proofs; the studies
 #               the offline modules register (railproof_study); the registry and layout checks.
 #   evidence  : the test suite's results (one ctest run, JUnit), tool versions, trace.json and
-#               the rendered evidence package in ${CMAKE_BINARY_DIR}/evidence.
+#               the rendered evidence package in ${CMAKE_BINARY_DIR}/evidence (verdict and
+#               reasons in evidence/evidence.json).
 set(RAILPROOF_VECTOR_DIR ${RAILPROOF_RESULTS_DIR}/vectors)
 set(_tg ${RAILPROOF_SOURCE_DIR}/testgen/railproof_testgen)
 # what every testgen command runs (the command line and its error types); each step adds the
@@ -161,14 +162,19 @@ add_custom_command(
   COMMENT "trace: requirement <-> property/vector/code/test links" VERBATIM)
 add_custom_target(railproof_trace ALL DEPENDS ${_trace})
 
+# The evidence reads every result above (it never runs a test: the JUnit files come from the
+# test-results step) and the design notes; it is rendered again when any of them changes.
 set(_manifest ${CMAKE_BINARY_DIR}/evidence/manifest.json)
 file(GLOB_RECURSE _evidence_sources CONFIGURE_DEPENDS ${RAILPROOF_SOURCE_DIR}/evidence/*)
-file(GLOB _evidence_py CONFIGURE_DEPENDS ${_tg}/evidence*.py ${_tg}/evidence/*.py)
+file(GLOB_RECURSE _evidence_py CONFIGURE_DEPENDS ${_tg}/evidence/*.py)
+file(GLOB _design_notes CONFIGURE_DEPENDS ${RAILPROOF_SOURCE_DIR}/spec/design/*.md)
 add_custom_command(
   OUTPUT ${_manifest}
   COMMAND ${RAILPROOF_TESTGEN} evidence --spec ${RAILPROOF_SOURCE_DIR}/spec --results ${RAILPROOF_RESULTS_DIR}
-          --src ${RAILPROOF_SOURCE_DIR} --out ${CMAKE_BINARY_DIR}/evidence --tool-versions ${_tools}
-  DEPENDS ${_trace} ${_test_stamp} ${_tools} ${_evidence_sources} ${_evidence_py}
+          --src ${RAILPROOF_SOURCE_DIR} --out ${CMAKE_BINARY_DIR}/evidence
+  DEPENDS ${_trace} ${_test_stamp} ${_tools} ${_layout} ${RAILPROOF_RESULTS_DIR}/registry.json
+          ${_spin_outputs} ${_vector_outputs} ${_proof_outputs} ${_study_outputs}
+          ${RAILPROOF_SPEC_FILES} ${_design_notes} ${_evidence_sources} ${_evidence_py} ${_tg_base}
   COMMENT "evidence: rendering the assessor's package (Sphinx + sphinx-needs)" VERBATIM)
 add_custom_target(evidence DEPENDS ${_manifest})
 
