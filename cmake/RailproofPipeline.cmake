@@ -168,14 +168,23 @@ set(_manifest ${CMAKE_BINARY_DIR}/evidence/manifest.json)
 file(GLOB_RECURSE _evidence_sources CONFIGURE_DEPENDS ${RAILPROOF_SOURCE_DIR}/evidence/*)
 file(GLOB_RECURSE _evidence_py CONFIGURE_DEPENDS ${_tg}/evidence/*.py)
 file(GLOB _design_notes CONFIGURE_DEPENDS ${RAILPROOF_SOURCE_DIR}/spec/design/*.md)
+set(_evidence_command ${RAILPROOF_TESTGEN} evidence --spec ${RAILPROOF_SOURCE_DIR}/spec --results ${RAILPROOF_RESULTS_DIR}
+    --src ${RAILPROOF_SOURCE_DIR} --out ${CMAKE_BINARY_DIR}/evidence)
 add_custom_command(
   OUTPUT ${_manifest}
-  COMMAND ${RAILPROOF_TESTGEN} evidence --spec ${RAILPROOF_SOURCE_DIR}/spec --results ${RAILPROOF_RESULTS_DIR}
-          --src ${RAILPROOF_SOURCE_DIR} --out ${CMAKE_BINARY_DIR}/evidence
+  COMMAND ${_evidence_command}
   DEPENDS ${_trace} ${_test_stamp} ${_tools} ${_layout} ${RAILPROOF_RESULTS_DIR}/registry.json
           ${_spin_outputs} ${_vector_outputs} ${_proof_outputs} ${_study_outputs}
           ${RAILPROOF_SPEC_FILES} ${_design_notes} ${_evidence_sources} ${_evidence_py} ${_tg_base}
+          ${_tg}/spec.py ${_tg}/toolversions.py
   COMMENT "evidence: rendering the assessor's package (Sphinx + sphinx-needs)" VERBATIM)
+# After a failed test suite the package is still rendered, from the results the failed run
+# left, with the verdict FAIL and its reasons (./railproof does this; it never depends on the
+# suite's success stamp).
+add_custom_target(evidence-after-failure
+  COMMAND ${_evidence_command}
+  DEPENDS ${_trace} ${_tools} ${_layout}
+  COMMENT "evidence: rendering the assessor's package after a failed test suite" VERBATIM)
 add_custom_target(evidence DEPENDS ${_manifest})
 
 # ---- pipeline checks in the test suite (they read the build's results) -----------------------
