@@ -1509,21 +1509,21 @@ std::string Simulation::Svg() const {
     plot.AddLegend(std::to_string(s.trains.size()) + " trains: front (thick), rear (thin)", SvgStyle{"#1f77b4", 1.6, "", 1.0});
   }
   plot.AddLegend("on-board stop limit (dashed)", SvgStyle{"#555555", 0.9, "5 4", 1.0});
-  plot.AddLegend("station platform", SvgStyle{"#999999", 1.0, "", 0.3}, true);
+  plot.AddLegend("station platform", SvgStyle{"#999999", 1.0, "", 0.3}, SvgPlot::LegendKind::kBox);
   if (any_poss) {
-    plot.AddLegend("possession requested / active", SvgStyle{"#ff9900", 1.0, "", 0.4}, true);
+    plot.AddLegend("possession requested / active", SvgStyle{"#ff9900", 1.0, "", 0.4}, SvgPlot::LegendKind::kBox);
   }
   if (any_tsr) {
-    plot.AddLegend("temporary speed restriction", SvgStyle{"#33aa33", 1.0, "", 0.3}, true);
+    plot.AddLegend("temporary speed restriction", SvgStyle{"#33aa33", 1.0, "", 0.3}, SvgPlot::LegendKind::kBox);
   }
   if (any_siding) {
-    plot.AddLegend("siding route requested", SvgStyle{"#3366ff", 1.0, "", 0.3}, true);
+    plot.AddLegend("siding route requested", SvgStyle{"#3366ff", 1.0, "", 0.3}, SvgPlot::LegendKind::kBox);
   }
   if (any_radio) {
-    plot.AddLegend("radio loss window", SvgStyle{"#ff0000", 1.0, "", 0.25}, true);
+    plot.AddLegend("radio loss window", SvgStyle{"#ff0000", 1.0, "", 0.25}, SvgPlot::LegendKind::kBox);
   }
   if (any_track) {
-    plot.AddLegend("tracking loss window", SvgStyle{"#9900cc", 1.0, "", 0.25}, true);
+    plot.AddLegend("tracking loss window", SvgStyle{"#9900cc", 1.0, "", 0.25}, SvgPlot::LegendKind::kBox);
   }
   for (std::size_t i = 0; i < s.violations.size() && i < 200; ++i) {
     plot.AddMarker(ToS(s.violations[i].t_ms), lo + (hi - lo) * 0.02, "#ff0000", i == 0 ? s.violations[i].requirement : "");

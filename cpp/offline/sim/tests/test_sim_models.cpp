@@ -1,5 +1,5 @@
 // Unit tests of the simulation's models: longitudinal dynamics (hand-checked cases),
-// supervision curves, the seeded channel, the SVG writer.
+// supervision curves, the seeded channel.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -12,7 +12,6 @@
 #include "railproof/tg/telegram.hpp"
 #include "railproof/sim/channel.hpp"
 #include "railproof/offline/dynamics.hpp"
-#include "railproof/offline/svg.hpp"
 
 namespace railproof::sim {
 using namespace ::railproof::offline;  // NOLINT(google-build-using-namespace)
@@ -207,35 +206,6 @@ TEST(SimChannel, CorruptedFramesAreCorrectedOrRejectedByTheFrameDecoder) {
   EXPECT_GT(corrected, 0);
   EXPECT_GT(rejected, 0);
   EXPECT_EQ(ch.Stats(Direction::kUplink).corrupted, 400U);
-}
-
-// ---- SVG writer --------------------------------------------------------------------------
-
-TEST(SimSvg, WritesAxesLinesShadesAndLegend) {
-  SvgPlot plot(0.0, 600.0, 0.0, 14.5);
-  plot.SetTitle("a <title> & more");
-  plot.SetXLabel("time [s]");
-  plot.SetYLabel("distance [km]");
-  plot.AddPolyline({{0.0, 1.0}, {100.0, 2.0}, {200.0, std::nan("")}, {300.0, 3.0}}, SvgStyle{"#ff0000", 1.5, "", 1.0});
-  plot.AddRect(100.0, 200.0, 5.0, 6.0, "#ff9900", 0.3, "possession 1");
-  plot.AddHLine(2.0, "A", SvgStyle{"#999999", 0.5, "2 3", 1.0});
-  plot.AddLegend("train 2", SvgStyle{"#ff0000", 1.5, "", 1.0});
-  const std::string svg = plot.Render();
-  EXPECT_EQ(svg.rfind("<?xml", 0), 0U);
-  EXPECT_NE(svg.find("<svg xmlns=\"http://www.w3.org/2000/svg\""), std::string::npos);
-  EXPECT_NE(svg.find("a &lt;title&gt; &amp; more"), std::string::npos);
-  EXPECT_NE(svg.find("time [s]"), std::string::npos);
-  EXPECT_NE(svg.find("distance [km]"), std::string::npos);
-  EXPECT_NE(svg.find("possession 1"), std::string::npos);
-  EXPECT_NE(svg.find("train 2"), std::string::npos);
-  EXPECT_NE(svg.find("stroke-dasharray=\"2 3\""), std::string::npos);
-  // the NaN breaks the polyline into two pieces
-  const auto path = svg.find("<path d=\"M");
-  ASSERT_NE(path, std::string::npos);
-  EXPECT_NE(svg.find(" M", path + 10), std::string::npos);
-  EXPECT_NE(svg.find("</svg>"), std::string::npos);
-  EXPECT_DOUBLE_EQ(SvgPlot::TickStep(0.0, 600.0, 12), 50.0);
-  EXPECT_DOUBLE_EQ(SvgPlot::TickStep(0.0, 14.5, 10), 2.0);
 }
 
 }  // namespace
