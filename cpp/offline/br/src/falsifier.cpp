@@ -18,6 +18,7 @@
 #include <mutex>
 
 #include "railproof/br/supervisor.hpp"
+#include "railproof/offline/dynamics.hpp"
 #include "railproof/offline/json_reader.hpp"
 
 namespace railproof::br::analysis {
@@ -84,7 +85,6 @@ void Cycle(const Env& env, SimState& s, const AdversaryStep& c) {
       s.eb_s = 0.0;
     }
   }
-  const double grav = static_cast<double>(pr.gravity_mm_s2) / 10000.0;
   const double onset = (static_cast<double>(pr.reaction_ms) + c.free_running_ms) / 1000.0;
   const double amax = static_cast<double>(m.train().accel_max_mm_s2) * c.traction;
   double left = static_cast<double>(pr.cycle_ms) / 1000.0;
@@ -94,17 +94,13 @@ void Cycle(const Env& env, SimState& s, const AdversaryStep& c) {
     if (s.eb_s >= 0.0 && !braking_now) {
       dt = std::min(dt, onset - s.eb_s);
     }
-    const double g = m.GradientUnderTrain(s.x_mm) + c.gradient_error_x10;
-    const double a = braking_now ? -(c.beta_mm_s2 + grav * g) : amax - grav * g;
-    if (a < 0.0 && s.v_mm_s + a * dt <= 0.0) {
-      if (s.v_mm_s > 0.0) {
-        s.x_mm += s.v_mm_s * s.v_mm_s / (-2.0 * a);
-      }
-      s.v_mm_s = 0.0;  // standing (the brake holds; traction cannot hold it: no roll-back)
-    } else {
-      s.x_mm += s.v_mm_s * dt + 0.5 * a * dt * dt;
-      s.v_mm_s += a * dt;
-    }
+    const double grade = GradeDecel((m.GradientUnderTrain(s.x_mm) + c.gradient_error_x10) / 10.0, m.Gravity());
+    const double a = braking_now ? -(c.beta_mm_s2 + grade) : amax - grade;
+    // the offline train-motion model: a train that stops stands (the brake holds; traction
+    // cannot hold it on a rise: no roll-back)
+    const Motion next = Advance({s.x_mm, s.v_mm_s}, a, dt);
+    s.x_mm = next.position;
+    s.v_mm_s = next.speed;
     if (s.eb_s >= 0.0) {
       s.eb_s += dt;
     }

@@ -35,12 +35,13 @@ Options ParseArgs(int argc, char** argv) {
   Options o;
   off::Cli cli("warning_study",
                "Warning-time study of level crossings (REQ-LC-017, also REQ-LC-002/005/008/015). Every\n"
-               "service of the timetable is simulated on the line (kinematic model, seeded driver\n"
-               "variation); for every crossing it passes, the warning time (arrival at\n"
-               "the near edge minus warning start) is computed for fixed treadles, the on-board request\n"
-               "(runtime lc::onboard::CrossingProtection: without and with dwell awareness, and\n"
-               "dwell-aware from the approach on) and GNSS-time pre-arming; trains the protection\n"
-               "pattern would brake are counted (runtime braking patterns and supervision).",
+               "service of the timetable is simulated on the line (the offline train-motion model\n"
+               "without gradients, seeded driver variation); for every crossing it passes, the\n"
+               "warning time (arrival at the near edge minus warning start) is computed for fixed\n"
+               "treadles, the on-board request (runtime lc::onboard::CrossingProtection: without and\n"
+               "with dwell awareness, and dwell-aware from the approach on) and GNSS-time pre-arming;\n"
+               "trains the protection pattern would brake are counted (runtime braking patterns and\n"
+               "supervision).",
                "Exit status: 0 pass; 1 a warning of an on-board or GNSS-time method below the design\n"
                "warning time, or a train braked by the protection pattern (named on stderr); 2 bad input.");
   cli.Add("--line", o.line, "generated line JSON (build/gen/lines/<line>.json)")->required();

@@ -120,8 +120,8 @@ struct TrainRt {
   std::vector<Sample> samples;
 
   [[nodiscard]] bool OnLine() const { return phase != Phase::kPending && phase != Phase::kExited; }
-  [[nodiscard]] double Rear() const { return motion.position_m - spec.performance.length_m; }
-  [[nodiscard]] std::int64_t FrontMm() const { return ToMm(motion.position_m); }
+  [[nodiscard]] double Rear() const { return motion.position - spec.performance.length_m; }
+  [[nodiscard]] std::int64_t FrontMm() const { return ToMm(motion.position); }
   [[nodiscard]] std::int64_t RearMm() const { return FrontMm() - length_mm; }
 };
 
@@ -236,7 +236,7 @@ struct Simulation::Impl {
       auto t = std::make_unique<TrainRt>();
       t->spec = spec;
       t->length_mm = ToMm(spec.performance.length_m);
-      t->motion.position_m = ToM(spec.initial_front_mm);
+      t->motion.position = ToM(spec.initial_front_mm);
       std::array<std::uint8_t, tg::kKeyBytes> kb{};
       for (auto& b : kb) {
         b = static_cast<std::uint8_t>(key_prng.Next() >> 56U);
@@ -378,16 +378,16 @@ struct Simulation::Impl {
     t.phase = Phase::kStanding;
     t.entered_ms = now;
     t.motion = Motion{ToM(t.spec.initial_front_mm), 0.0};
-    t.est_front_m = t.motion.position_m;
+    t.est_front_m = t.motion.position;
     t.balise_est_m = t.est_front_m;
-    t.balise_true_m = t.motion.position_m;
+    t.balise_true_m = t.motion.position;
     t.last_balise_mm = t.spec.initial_front_mm;
     t.odo_error = -kOdometryErrorShare * static_cast<double>(mbp::length_correction_ppm) / 1e6 * odo_prng.Uniform();
     t.next_balise = 0;
     while (t.next_balise < rl->balises.size() && rl->balises[t.next_balise].position_mm <= t.spec.initial_front_mm) {
       ++t.next_balise;
     }
-    t.start_m = t.motion.position_m;
+    t.start_m = t.motion.position;
     // spread the report instants of the trains over the period
     t.next_report_ms = now + (static_cast<std::int64_t>(t.spec.id) * sc.step_ms) % sc.report_period_ms;
     Emit(Json{{"ev", "enter"}, {"train", t.spec.id}, {"front_mm", t.spec.initial_front_mm}, {"length_mm", t.length_mm}});
@@ -398,7 +398,7 @@ struct Simulation::Impl {
     channel.Purge(t.spec.id);
     t.phase = Phase::kExited;
     t.exited_ms = now;
-    t.motion.speed_mps = 0.0;
+    t.motion.speed = 0.0;
     Emit(Json{{"ev", "exit"}, {"train", t.spec.id}, {"front_mm", t.FrontMm()}, {"reason", why}});
   }
 
@@ -735,7 +735,7 @@ struct Simulation::Impl {
         rep.length_mm = t->length_mm;
         rep.correction_mm = CorrectionMm(*t);
         rep.last_balise_mm = t->last_balise_mm;
-        rep.speed_mm_s = static_cast<std::int64_t>(std::llround(t->motion.speed_mps * 1000.0));
+        rep.speed_mm_s = static_cast<std::int64_t>(std::llround(t->motion.speed * 1000.0));
         rep.direction = mb::wayside::Direction::kNominal;
         payload = EncodePosition(rep);
         ++t->reports_sent;
@@ -758,14 +758,12 @@ struct Simulation::Impl {
   [[nodiscard]] double LineSpeed(const TrainRt& t, double safe_front, double rear, double b, double look) const {
     double v = std::numeric_limits<double>::infinity();
     const double front = safe_front + look;
+    const auto limit_mps = [](const SpeedLimit& s) { return static_cast<double>(s.kmh) / 3.6; };
+    rl->ForEachLimitActing(rear, front, [&](std::size_t i) { v = std::min(v, limit_mps(rl->speed_limits[i])); }, 1000.0);
     for (const auto& s : rl->speed_limits) {
-      const double lim = static_cast<double>(s.kmh) / 3.6;
       const double begin = ToM(s.section.begin_mm);
-      const double end = ToM(s.section.end_mm);
-      if (begin < front && rear < end) {
-        v = std::min(v, lim);
-      } else if (begin >= front) {
-        v = std::min(v, std::sqrt(lim * lim + 2.0 * b * (begin - front)));
+      if (begin > front) {  // ahead: the speed from which braking with b reaches the limit at its begin
+        v = std::min(v, SpeedAfter(limit_mps(s), b, begin - front));
       }
     }
     const auto front_mm = ToMm(t.est_front_m);
@@ -776,7 +774,7 @@ struct Simulation::Impl {
       const double begin = ToM(r.begin_mm);
       const double lim = static_cast<double>(r.speed_mm_s) / 1000.0;
       if (begin >= front) {
-        v = std::min(v, std::sqrt(lim * lim + 2.0 * b * (begin - front)));
+        v = std::min(v, SpeedAfter(lim, b, begin - front));
       } else if (rear < ToM(r.end_mm)) {
         v = std::min(v, lim);
       }
@@ -786,7 +784,7 @@ struct Simulation::Impl {
 
   Control Drive(TrainRt& t, double dt) {
     const TrainPerformance& p = t.spec.performance;
-    const double v = t.motion.speed_mps;
+    const double v = t.motion.speed;
     const double corr = ToM(CorrectionMm(t));
     const double safe_front = t.est_front_m + corr;
     const double rear = t.est_front_m - p.length_m - corr;
@@ -809,8 +807,8 @@ struct Simulation::Impl {
     const double limit = ToM(*limit_mm);
     const double d = limit - safe_front;
     const double fall = SteepestFall(safe_front, std::max(safe_front, limit) + 1.0);
-    const double bs = std::max(0.05, p.service_decel_mps2 - kGravity * fall / 1000.0);
-    const double be = std::max(0.05, p.emergency_decel_mps2 - kGravity * fall / 1000.0);
+    const double bs = std::max(0.05, p.service_decel_mps2 - GradeDecel(fall));
+    const double be = std::max(0.05, p.emergency_decel_mps2 - GradeDecel(fall));
     const double v_e = CurveSpeed(d, be, sc.supervision.emergency_free_running_s);
     if (v > v_e + 1e-9 && !t.eb) {
       ++t.emergency_brakes;
@@ -845,7 +843,7 @@ struct Simulation::Impl {
       c.brake_mps2 = p.service_decel_mps2;  // stopping or standing: full service brake holds the train
       return c;
     }
-    const double other = NetAcceleration(p, Control{}, v, MeanGradient(t.motion.position_m - p.length_m, t.motion.position_m));
+    const double other = NetAcceleration(p, Control{}, v, MeanGradient(t.motion.position - p.length_m, t.motion.position));
     const double need = (target - v) / dt - other;  // applied acceleration needed
     if (need > 0.0) {
       c.traction_mps2 = std::min(need, p.accel_mps2);
@@ -891,16 +889,16 @@ struct Simulation::Impl {
         }
       }
       const Control c = Drive(t, dt);
-      const double grad = MeanGradient(t.motion.position_m - t.spec.performance.length_m, t.motion.position_m);
-      const double a = NetAcceleration(t.spec.performance, c, t.motion.speed_mps, grad);
+      const double grad = MeanGradient(t.motion.position - t.spec.performance.length_m, t.motion.position);
+      const double a = NetAcceleration(t.spec.performance, c, t.motion.speed, grad);
       const Motion before = t.motion;
       t.motion = offline::Advance(before, a, dt);
-      const double moved = t.motion.position_m - before.position_m;
+      const double moved = t.motion.position - before.position;
       // odometry: under-reads by odo_error; a balise passed resets it
       t.est_front_m += moved * (1.0 + t.odo_error);
-      while (t.next_balise < rl->balises.size() && ToMm(t.motion.position_m) >= rl->balises[t.next_balise].position_mm) {
+      while (t.next_balise < rl->balises.size() && ToMm(t.motion.position) >= rl->balises[t.next_balise].position_mm) {
         const auto& b = rl->balises[t.next_balise];
-        const double beyond = t.motion.position_m - ToM(b.position_mm);
+        const double beyond = t.motion.position - ToM(b.position_mm);
         t.odo_error = -kOdometryErrorShare * static_cast<double>(mbp::length_correction_ppm) / 1e6 * odo_prng.Uniform();
         t.balise_est_m = ToM(b.position_mm);
         t.balise_true_m = ToM(b.position_mm);
@@ -911,12 +909,12 @@ struct Simulation::Impl {
           Emit(Json{{"ev", "balise"}, {"train", t.spec.id}, {"balise", b.id}});
         }
       }
-      t.max_speed = std::max(t.max_speed, t.motion.speed_mps);
-      if (t.phase == Phase::kRunning && t.motion.speed_mps <= 0.0 && (t.eb || !t.auth.Usable(now))) {
+      t.max_speed = std::max(t.max_speed, t.motion.speed);
+      if (t.phase == Phase::kRunning && t.motion.speed <= 0.0 && (t.eb || !t.auth.Usable(now))) {
         t.standstill_no_authority_ms += sc.step_ms;
       }
       // station arrival
-      if (t.phase == Phase::kRunning && t.motion.speed_mps <= 0.0 && t.next_stop < t.spec.stops.size()) {
+      if (t.phase == Phase::kRunning && t.motion.speed <= 0.0 && t.next_stop < t.spec.stops.size()) {
         const Station* st = rl->FindStation(t.spec.stops[t.next_stop].station);
         const double ds = ToM(st->stop_mm) - t.est_front_m;
         if (ds <= kStopWindowM) {
@@ -933,7 +931,7 @@ struct Simulation::Impl {
         continue;
       }
       // end of the line: leaves the area (removed from the ground)
-      if (t.phase == Phase::kRunning && t.motion.speed_mps <= 0.0 && t.next_stop >= t.spec.stops.size() &&
+      if (t.phase == Phase::kRunning && t.motion.speed <= 0.0 && t.next_stop >= t.spec.stops.size() &&
           t.limit_kind == messages::Obstruction::kEndOfTrack && t.auth.Limit()) {
         const double d = ToM(*t.auth.Limit()) - t.est_front_m - ToM(CorrectionMm(t));
         if (d <= sc.supervision.margin_m + kExitWindowM) {
@@ -954,7 +952,7 @@ struct Simulation::Impl {
       }
     }
     std::sort(on.begin(), on.end(),
-              [](const TrainRt* a, const TrainRt* b) { return a->motion.position_m < b->motion.position_m; });
+              [](const TrainRt* a, const TrainRt* b) { return a->motion.position < b->motion.position; });
     // REQ-MB-008 separation (true ranges; neighbours in front order suffice)
     ++checks["REQ-MB-008"].checks;
     for (std::size_t i = 1; i < on.size(); ++i) {
@@ -975,9 +973,9 @@ struct Simulation::Impl {
       // ASM-013: the true front never passes the last accepted stop limit
       ++checks["ASM-013"].checks;
       const double bound = lim ? ToM(*lim) : ToM(t.spec.initial_front_mm);
-      if (t.motion.position_m > bound + kLimitToleranceM) {
+      if (t.motion.position > bound + kLimitToleranceM) {
         Violate("ASM-013", std::to_string(t.spec.id),
-                "train " + std::to_string(t.spec.id) + " front " + Fmt(t.motion.position_m) +
+                "train " + std::to_string(t.spec.id) + " front " + Fmt(t.motion.position) +
                     " m beyond its on-board stop limit " + Fmt(bound) + " m");
       }
       if (!lim || !t.auth.Usable(now)) {
@@ -1046,10 +1044,10 @@ struct Simulation::Impl {
       if (t == nullptr || !t->OnLine()) {
         continue;
       }
-      if (!f.ended && !f.standstill_at && t->motion.speed_mps <= 0.0) {
+      if (!f.ended && !f.standstill_at && t->motion.speed <= 0.0) {
         f.standstill_at = now;
       }
-      if (f.ended && !f.moving_again_at && t->motion.speed_mps > 0.0) {
+      if (f.ended && !f.moving_again_at && t->motion.speed > 0.0) {
         f.moving_again_at = now;
       }
     }
@@ -1057,13 +1055,13 @@ struct Simulation::Impl {
       const TrainRt* l = Find(sc.gap->leader);
       const TrainRt* f = Find(sc.gap->follower);
       if (l != nullptr && f != nullptr && l->OnLine() && f->OnLine()) {
-        const double gap = l->Rear() - f->motion.position_m;
+        const double gap = l->Rear() - f->motion.position;
         ++gap_n;
         gap_sum += gap;
         gap_min = std::min(gap_min, gap);
         gap_max = std::max(gap_max, gap);
-        gap_vl += l->motion.speed_mps;
-        gap_vf += f->motion.speed_mps;
+        gap_vl += l->motion.speed;
+        gap_vf += f->motion.speed;
       }
     }
     if (now % sc.sample_ms == 0) {
@@ -1073,7 +1071,7 @@ struct Simulation::Impl {
         }
         const auto lim = t->auth.Limit();
         const bool usable = lim && t->auth.Usable(now);
-        t->samples.push_back(Sample{now, t->motion.position_m, t->Rear(), usable ? ToM(*lim) : std::nan("")});
+        t->samples.push_back(Sample{now, t->motion.position, t->Rear(), usable ? ToM(*lim) : std::nan("")});
       }
     }
   }
@@ -1156,9 +1154,9 @@ std::vector<TrainView> Simulation::Trains() const {
     TrainView v;
     v.id = t->spec.id;
     v.phase = ToString(t->phase);
-    v.front_m = t->motion.position_m;
+    v.front_m = t->motion.position;
     v.rear_m = t->Rear();
-    v.speed_mps = t->motion.speed_mps;
+    v.speed_mps = t->motion.speed;
     if (const auto lim = t->auth.Limit()) {
       v.limit_m = ToM(*lim);
     }
@@ -1276,13 +1274,13 @@ nlohmann::ordered_json Simulation::Summary() const {
     entered += t->entered_ms >= 0 ? 1U : 0U;
     exited += t->exited_ms >= 0 ? 1U : 0U;
     last_exit = std::max(last_exit, t->exited_ms);
-    const double dist = t->entered_ms >= 0 ? t->motion.position_m - t->start_m : 0.0;
+    const double dist = t->entered_ms >= 0 ? t->motion.position - t->start_m : 0.0;
     total_km += dist / 1000.0;
     trains.push_back(Json{{"id", t->spec.id},
                           {"phase", ToString(t->phase)},
                           {"entered_s", t->entered_ms >= 0 ? Json(ToS(t->entered_ms)) : Json(nullptr)},
                           {"exited_s", t->exited_ms >= 0 ? Json(ToS(t->exited_ms)) : Json(nullptr)},
-                          {"front_m", R1(t->motion.position_m)},
+                          {"front_m", R1(t->motion.position)},
                           {"distance_m", R1(dist)},
                           {"max_speed_kmh", R1(t->max_speed * 3.6)},
                           {"stops_made", t->stops_made},
