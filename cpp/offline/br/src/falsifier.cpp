@@ -163,6 +163,20 @@ nlohmann::ordered_json StepJson(const AdversaryStep& c) {
           {"stale_mm", c.stale_mm}};
 }
 
+// The step of a regression case (the inverse of StepJson).
+AdversaryStep StepFromJson(const offline::JsonNode& st) {
+  AdversaryStep c;
+  c.cycles = static_cast<int>(st.Key("cycles").Int());
+  c.traction = st.Key("traction").Number();
+  c.speed_error = st.Key("speed_error").Number();
+  c.beta_mm_s2 = st.Key("beta_mm_s2").Number();
+  c.free_running_ms = st.Key("free_running_ms").Number();
+  c.gradient_error_x10 = st.Key("gradient_error_x10").Number();
+  c.position_error_mm = st.Key("position_error_mm").Number();
+  c.stale_mm = st.Key("stale_mm").Number();
+  return c;
+}
+
 std::mutex& OmplMutex() {
   static std::mutex mu;
   return mu;
@@ -332,40 +346,23 @@ ReplayResult ReplayCase(const nlohmann::json& doc, const TrainType& train, const
   }
   ReplayResult r;
   r.max_overrun_mm = s.x_mm - static_cast<double>(env.l_mm);
-  for (const auto& st : root.Key("steps").Array()) {
-    AdversaryStep c;
-    c.cycles = static_cast<int>(st.Key("cycles").Int());
-    c.traction = st.Key("traction").Number();
-    c.speed_error = st.Key("speed_error").Number();
-    c.beta_mm_s2 = st.Key("beta_mm_s2").Number();
-    c.free_running_ms = st.Key("free_running_ms").Number();
-    c.gradient_error_x10 = st.Key("gradient_error_x10").Number();
-    c.position_error_mm = st.Key("position_error_mm").Number();
-    c.stale_mm = st.Key("stale_mm").Number();
-    c = Clamp(env, c);
+  const auto cycle = [&](const AdversaryStep& c) {
+    Cycle(env, s, c);
+    ++r.cycles;
+    r.max_overrun_mm = std::max(r.max_overrun_mm, s.x_mm - static_cast<double>(env.l_mm));
+  };
+  const auto steps = root.Key("steps").Array();
+  for (const auto& st : steps) {
+    const AdversaryStep c = Clamp(env, StepFromJson(st));
     for (int k = 0; k < c.cycles; ++k) {
-      Cycle(env, s, c);
-      ++r.cycles;
-      r.max_overrun_mm = std::max(r.max_overrun_mm, s.x_mm - static_cast<double>(env.l_mm));
+      cycle(c);
     }
   }
   // after the recorded controls: keep the last control until standstill (bounded)
-  const auto steps = root.Key("steps").Array();
   if (!steps.empty()) {
-    AdversaryStep c;
-    const auto& st = steps.back();
-    c.traction = st.Key("traction").Number();
-    c.speed_error = st.Key("speed_error").Number();
-    c.beta_mm_s2 = st.Key("beta_mm_s2").Number();
-    c.free_running_ms = st.Key("free_running_ms").Number();
-    c.gradient_error_x10 = st.Key("gradient_error_x10").Number();
-    c.position_error_mm = st.Key("position_error_mm").Number();
-    c.stale_mm = st.Key("stale_mm").Number();
-    c = Clamp(env, c);
+    const AdversaryStep c = Clamp(env, StepFromJson(steps.back()));
     for (int k = 0; k < 3000 && (s.v_mm_s > 0.0 || s.eb_s < 0.0); ++k) {
-      Cycle(env, s, c);
-      ++r.cycles;
-      r.max_overrun_mm = std::max(r.max_overrun_mm, s.x_mm - static_cast<double>(env.l_mm));
+      cycle(c);
       if (s.v_mm_s <= 0.0 && s.eb_s >= 0.0) {
         break;
       }

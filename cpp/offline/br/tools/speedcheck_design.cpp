@@ -204,7 +204,6 @@ Json ComparisonJson(const an::SpeedCheckDesign& d, const std::string& what) {
   return j;
 }
 
-
 // @implements REQ-SC-002 REQ-SC-004 REQ-SC-005 REQ-SC-006
 int Main(int argc, char** argv) {
   const Options o = ParseArgs(argc, argv);

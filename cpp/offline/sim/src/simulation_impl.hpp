@@ -18,6 +18,7 @@
 #include <memory>
 #include <optional>
 #include <set>
+#include <span>
 #include <string>
 #include <utility>
 #include <vector>
@@ -232,7 +233,14 @@ struct Simulation::Impl {
   [[nodiscard]] std::int64_t SidingRoute(const FaultSpec& s) const;
 
   // ---- telegrams between the trains and the ground, the ground cycle (simulation_radio.cpp)
+  // Frames due now: a position report to the ground, a stop-limit telegram to the train.
   void DeliverFrames();
+  // The payload of a frame its endpoint accepts (counted per direction); a rejected frame is
+  // counted and logged (nullopt). A train's endpoint also updates the train's link state.
+  std::optional<std::span<const std::uint8_t>> Accept(tg::Endpoint& ep, TrainRt& t, const Frame& f, bool uplink,
+                                                      std::span<std::uint8_t> buffer);
+  void OnPositionReport(TrainRt& t, const Frame& f, std::span<const std::uint8_t> payload);
+  void OnStopLimit(TrainRt& t, std::span<const std::uint8_t> payload);
   [[nodiscard]] std::int64_t ToFront(const messages::PositionReport& r) const;
   // Canonical block + offset: the block holding front - 1 (block 0 for front 0).
   [[nodiscard]] std::pair<std::uint32_t, std::int64_t> Locate(std::int64_t front_mm) const;

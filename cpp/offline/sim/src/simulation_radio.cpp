@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <map>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -15,82 +16,95 @@
 namespace railproof::sim {
 
 void Simulation::Impl::DeliverFrames() {
-  std::array<std::uint8_t, tg::kPayloadMax> payload{};
+  std::array<std::uint8_t, tg::kPayloadMax> buffer{};
   for (Frame& f : channel.Deliver(now)) {
     TrainRt* t = Find(f.train);
     if (t == nullptr || !t->OnLine()) {
       continue;
     }
-    if (f.direction == Direction::kUplink) {
-      const auto r = t->ground_ep.Receive(Clock32(now), f.bytes, payload);
-      if (r.reason != tg::RejectReason::kNone) {
-        ++up.rejected[VerdictName(r.reason)];
-        Emit(Json{{"ev", "telegram_rejected"}, {"dir", "up"}, {"train", t->spec.id}, {"reason", VerdictName(r.reason)},
-                  {"sent_ms", f.sent_ms}, {"corrupted_symbols", f.corrupted_symbols}});
-        continue;
-      }
-      ++up.accepted;
-      bool malformed = false;
-      const auto rep = DecodePosition(std::span<const std::uint8_t>(payload).first(r.header.payload_len), malformed);
-      if (malformed) {
-        ++up.malformed;
-        continue;
-      }
-      if (!rep) {
-        continue;  // no position (tracking loss on board): nothing for the ground
-      }
-      if (rep->train_id != t->spec.id) {
-        ++up.malformed;
-        continue;
-      }
-      const auto st = ground->OnReport(*rep);
-      ++report_status[mb::wayside::ToString(st)];
-      if (st == mb::wayside::ReportStatus::kAccepted) {
-        ++t->reports_accepted;
-        if (Full()) {
-          Emit(Json{{"ev", "report"}, {"train", t->spec.id}, {"front_mm", ToFront(*rep)}, {"correction_mm", rep->correction_mm},
-                    {"speed_mm_s", rep->speed_mm_s}, {"sent_ms", f.sent_ms}, {"status", "Accepted"}});
-        }
-      } else {
-        Emit(Json{{"ev", "report"}, {"train", t->spec.id}, {"front_mm", ToFront(*rep)}, {"status", mb::wayside::ToString(st)}});
-      }
-    } else {
-      const auto r = t->train_ep.Receive(Clock32(now), f.bytes, payload);
-      t->link_up = r.link == tg::LinkState::kUp;
-      if (r.reason != tg::RejectReason::kNone) {
-        ++down.rejected[VerdictName(r.reason)];
-        Emit(Json{{"ev", "telegram_rejected"}, {"dir", "down"}, {"train", t->spec.id}, {"reason", VerdictName(r.reason)},
-                  {"sent_ms", f.sent_ms}, {"corrupted_symbols", f.corrupted_symbols}});
-        continue;
-      }
-      ++down.accepted;
-      bool malformed = false;
-      const auto tg = DecodeStopLimit(std::span<const std::uint8_t>(payload).first(r.header.payload_len), malformed);
-      if (malformed || (tg && tg->train_id != t->spec.id)) {
-        ++down.malformed;
-        continue;
-      }
-      if (!tg) {
-        continue;  // keep-alive: no limit for this train
-      }
-      const auto before = t->auth.Limit();
-      const auto v = t->auth.Receive(tg->limit_mm, tg->issue_time_ms, now);
-      ++verdicts[mb::onboard::ToString(v)];
-      if (v == mb::onboard::Verdict::kAccept) {
-        const bool changed_kind = tg->kind != t->limit_kind;
-        t->limit_kind = tg->kind;
-        t->tsr.Update(std::span<const messages::SpeedRestriction>(tg->restrictions.data(), tg->restriction_count),
-                      ToMm(t->est_front_m), t->length_mm);
-        if (Full() || !before || *before > tg->limit_mm || changed_kind) {
-          Emit(Json{{"ev", "limit"}, {"train", t->spec.id}, {"limit_mm", tg->limit_mm}, {"kind", messages::ToString(tg->kind)},
-                    {"issue_ms", tg->issue_time_ms}, {"age_ms", now - tg->issue_time_ms},
-                    {"previous_mm", before ? Json(*before) : Json(nullptr)}});
-        }
-      } else {
-        Emit(Json{{"ev", "limit_refused"}, {"train", t->spec.id}, {"verdict", mb::onboard::ToString(v)},
-                  {"limit_mm", tg->limit_mm}, {"issue_ms", tg->issue_time_ms}});
-      }
+    const bool uplink = f.direction == Direction::kUplink;
+    const auto payload = Accept(uplink ? t->ground_ep : t->train_ep, *t, f, uplink, buffer);
+    if (!payload) {
+      continue;
     }
+    if (uplink) {
+      OnPositionReport(*t, f, *payload);
+    } else {
+      OnStopLimit(*t, *payload);
+    }
+  }
+}
+
+std::optional<std::span<const std::uint8_t>> Simulation::Impl::Accept(tg::Endpoint& ep, TrainRt& t, const Frame& f,
+                                                                      bool uplink, std::span<std::uint8_t> buffer) {
+  const auto r = ep.Receive(Clock32(now), f.bytes, buffer);
+  if (!uplink) {
+    t.link_up = r.link == tg::LinkState::kUp;
+  }
+  DirStats& stats = uplink ? up : down;
+  if (r.reason != tg::RejectReason::kNone) {
+    ++stats.rejected[VerdictName(r.reason)];
+    Emit(Json{{"ev", "telegram_rejected"}, {"dir", uplink ? "up" : "down"}, {"train", t.spec.id},
+              {"reason", VerdictName(r.reason)}, {"sent_ms", f.sent_ms}, {"corrupted_symbols", f.corrupted_symbols}});
+    return std::nullopt;
+  }
+  ++stats.accepted;
+  return std::span<const std::uint8_t>(buffer).first(r.header.payload_len);
+}
+
+void Simulation::Impl::OnPositionReport(TrainRt& t, const Frame& f, std::span<const std::uint8_t> payload) {
+  bool malformed = false;
+  const auto rep = DecodePosition(payload, malformed);
+  if (malformed) {
+    ++up.malformed;
+    return;
+  }
+  if (!rep) {
+    return;  // no position (tracking loss on board): nothing for the ground
+  }
+  if (rep->train_id != t.spec.id) {
+    ++up.malformed;
+    return;
+  }
+  const auto st = ground->OnReport(*rep);
+  ++report_status[mb::wayside::ToString(st)];
+  if (st == mb::wayside::ReportStatus::kAccepted) {
+    ++t.reports_accepted;
+    if (Full()) {
+      Emit(Json{{"ev", "report"}, {"train", t.spec.id}, {"front_mm", ToFront(*rep)}, {"correction_mm", rep->correction_mm},
+                {"speed_mm_s", rep->speed_mm_s}, {"sent_ms", f.sent_ms}, {"status", "Accepted"}});
+    }
+  } else {
+    Emit(Json{{"ev", "report"}, {"train", t.spec.id}, {"front_mm", ToFront(*rep)}, {"status", mb::wayside::ToString(st)}});
+  }
+}
+
+void Simulation::Impl::OnStopLimit(TrainRt& t, std::span<const std::uint8_t> payload) {
+  bool malformed = false;
+  const auto tg = DecodeStopLimit(payload, malformed);
+  if (malformed || (tg && tg->train_id != t.spec.id)) {
+    ++down.malformed;
+    return;
+  }
+  if (!tg) {
+    return;  // keep-alive: no limit for this train
+  }
+  const auto before = t.auth.Limit();
+  const auto v = t.auth.Receive(tg->limit_mm, tg->issue_time_ms, now);
+  ++verdicts[mb::onboard::ToString(v)];
+  if (v == mb::onboard::Verdict::kAccept) {
+    const bool changed_kind = tg->kind != t.limit_kind;
+    t.limit_kind = tg->kind;
+    t.tsr.Update(std::span<const messages::SpeedRestriction>(tg->restrictions.data(), tg->restriction_count),
+                 ToMm(t.est_front_m), t.length_mm);
+    if (Full() || !before || *before > tg->limit_mm || changed_kind) {
+      Emit(Json{{"ev", "limit"}, {"train", t.spec.id}, {"limit_mm", tg->limit_mm}, {"kind", messages::ToString(tg->kind)},
+                {"issue_ms", tg->issue_time_ms}, {"age_ms", now - tg->issue_time_ms},
+                {"previous_mm", before ? Json(*before) : Json(nullptr)}});
+    }
+  } else {
+    Emit(Json{{"ev", "limit_refused"}, {"train", t.spec.id}, {"verdict", mb::onboard::ToString(v)},
+              {"limit_mm", tg->limit_mm}, {"issue_ms", tg->issue_time_ms}});
   }
 }
 

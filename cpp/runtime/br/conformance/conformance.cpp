@@ -164,20 +164,12 @@ class VectorTest : public testing::Test {
 };
 
 
-constexpr const char* kDescription =
-    "Replays every br*.jsonl vector of DIR against the C++ speed-supervision decision\n"
-    "(br::Supervisor). Exit 0 only if every vector matches.";
-
 }  // namespace
 
 int main(int argc, char** argv) {
-  return rcli::RunnerMain(
-      "railproof-conformance-br", "BrakingConformance", kDescription, argc, argv,
-      [](const std::string& dir) {
-        std::string error;
-        const bool ok = Load(dir, error);
-        return rcli::LoadedSet{ok, error, g_vectors.size(), g_files.size()};
-      },
-      [](std::size_t i) { return rcli::SiteOf(g_vectors, i); },
-      [](std::size_t i) -> testing::Test* { return new VectorTest(i); }, g_mismatched, g_replayed);
+  return rcli::RunnerMain<VectorTest>(
+      "railproof-conformance-br", "BrakingConformance",
+      "Replays every br*.jsonl vector of DIR against the C++ speed-supervision decision\n"
+      "(br::Supervisor). Exit 0 only if every vector matches.",
+      argc, argv, Load, g_vectors, g_files, g_mismatched, g_replayed);
 }

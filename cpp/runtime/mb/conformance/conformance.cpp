@@ -334,15 +334,12 @@ class VectorTest : public testing::Test {
   std::size_t index_;
 };
 
-
-constexpr const char* kDescription =
-    "Replays every mb*.jsonl vector of DIR against the C++ ground and on-board units.";
-
 }  // namespace
 
 int main(int argc, char** argv) {
   return rcli::RunnerMain(
-      "railproof-conformance-mb", "MovingBlockConformance", kDescription, argc, argv,
+      "railproof-conformance-mb", "MovingBlockConformance",
+      "Replays every mb*.jsonl vector of DIR against the C++ ground and on-board units.", argc, argv,
       [](const std::string& dir) {
         std::string error;
         const bool ok = Load(dir, error);

@@ -246,21 +246,13 @@ class VectorTest : public testing::Test {
   std::size_t index_;
 };
 
-constexpr const char* kDescription =
-    "Replays every ra*.jsonl vector of DIR against the C++ re-adhesion state machine\n"
-    "(ra::ReadhesionMachine), configured by each file's header. Exit 0 only if every\n"
-    "vector matches.";
-
 }  // namespace
 
 int main(int argc, char** argv) {
-  return rcli::RunnerMain(
-      "railproof-conformance-ra", "ReadhesionConformance", kDescription, argc, argv,
-      [](const std::string& dir) {
-        std::string error;
-        const bool ok = Load(dir, error);
-        return rcli::LoadedSet{ok, error, g_vectors.size(), g_files.size()};
-      },
-      [](std::size_t i) { return rcli::SiteOf(g_vectors, i); },
-      [](std::size_t i) -> testing::Test* { return new VectorTest(i); }, g_mismatched, g_replayed);
+  return rcli::RunnerMain<VectorTest>(
+      "railproof-conformance-ra", "ReadhesionConformance",
+      "Replays every ra*.jsonl vector of DIR against the C++ re-adhesion state machine\n"
+      "(ra::ReadhesionMachine), configured by each file's header. Exit 0 only if every\n"
+      "vector matches.",
+      argc, argv, Load, g_vectors, g_files, g_mismatched, g_replayed);
 }

@@ -227,17 +227,15 @@ class VectorTest : public testing::Test {
   std::size_t index_;
 };
 
-
-constexpr const char* kDescription =
-    "Replays every vector of DIR/*.jsonl (spec/design/tg.md §7) against the radio endpoint;\n"
-    "one test per vector. Exit 0 only if the set is non-empty, well formed and every vector\n"
-    "passes.";
-
 }  // namespace
 
 int main(int argc, char** argv) {
   return rcli::RunnerMain(
-      "railproof-conformance-tg", "TelegramConformance", kDescription, argc, argv,
+      "railproof-conformance-tg", "TelegramConformance",
+      "Replays every vector of DIR/*.jsonl (spec/design/tg.md §7) against the radio endpoint;\n"
+      "one test per vector. Exit 0 only if the set is non-empty, well formed and every vector\n"
+      "passes.",
+      argc, argv,
       [](const std::string& dir) {
         rc::LoadResult loaded = rc::LoadVectorDirectory(dir);
         std::set<std::string> files;

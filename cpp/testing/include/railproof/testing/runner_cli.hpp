@@ -16,6 +16,7 @@
 #include <atomic>
 #include <cstddef>
 #include <cstdio>
+#include <filesystem>
 #include <functional>
 #include <optional>
 #include <string>
@@ -184,6 +185,23 @@ inline int RunnerMain(const char* prog, const char* suite, const std::string& de
   ReportLoad(prog, set.ok, set.error, n, set.files, args.vectors_dir);
   const int rc_tests = RUN_ALL_TESTS();
   return Finish(prog, set.ok, set.error, mismatched.load(), replayed.load(), n, rc_tests);
+}
+
+// RunnerMain for a runner whose load(dir, error) fills `vectors` (each knowing its test name,
+// file and line) and the set of `files`, and whose Test is constructed from a vector's index.
+template <typename Test, typename Vectors, typename Files>
+int RunnerMain(const char* prog, const char* suite, const std::string& description, int argc, char** argv,
+               bool (*load)(const std::filesystem::path& dir, std::string& error), const Vectors& vectors,
+               const Files& files, const std::atomic<std::size_t>& mismatched, const std::atomic<std::size_t>& replayed) {
+  return RunnerMain(
+      prog, suite, description, argc, argv,
+      [&](const std::string& dir) {
+        std::string error;
+        const bool ok = load(dir, error);
+        return LoadedSet{ok, error, vectors.size(), files.size()};
+      },
+      [&](std::size_t i) { return SiteOf(vectors, i); }, [](std::size_t i) -> testing::Test* { return new Test(i); },
+      mismatched, replayed);
 }
 
 }  // namespace railproof::conformance
