@@ -9,6 +9,9 @@
 //   - RunTool() is the tool's main(): bad input (InputError) prints "<tool>: <reason>", any
 //     other exception "<tool>: error: <reason>", both exit 2.
 // The conformance runners use CLI11 the same way (railproof/testing/runner_cli.hpp).
+// Why a library: one well-kept parser for every tool and runner instead of three hand-written
+// ones, and the help is generated from the same table that parses, so a usage text cannot
+// drift from the options; what is the project's own is only these conventions.
 // Offline module (may allocate and throw).
 #pragma once
 
@@ -56,7 +59,7 @@ CLI::Option* Repeatable(CLI::Option* option, bool empty);
 class Cli {
  public:
   // `tool` is the program name in the usage line and the prefix of every message;
-  // `description` follows the usage line of --help, `footer` the options (exit status).
+  // `description` opens --help, `footer` follows the options (the exit status).
   Cli(std::string tool, const std::string& description, const std::string& footer = "");
   Cli(const Cli&) = delete;
   Cli& operator=(const Cli&) = delete;
