@@ -18,6 +18,7 @@
 #include <mutex>
 
 #include "railproof/br/supervisor.hpp"
+#include "railproof/offline/dynamics.hpp"
 #include "railproof/offline/json_reader.hpp"
 
 namespace railproof::br::analysis {
@@ -84,7 +85,6 @@ void Cycle(const Env& env, SimState& s, const AdversaryStep& c) {
       s.eb_s = 0.0;
     }
   }
-  const double grav = static_cast<double>(pr.gravity_mm_s2) / 10000.0;
   const double onset = (static_cast<double>(pr.reaction_ms) + c.free_running_ms) / 1000.0;
   const double amax = static_cast<double>(m.train().accel_max_mm_s2) * c.traction;
   double left = static_cast<double>(pr.cycle_ms) / 1000.0;
@@ -94,17 +94,13 @@ void Cycle(const Env& env, SimState& s, const AdversaryStep& c) {
     if (s.eb_s >= 0.0 && !braking_now) {
       dt = std::min(dt, onset - s.eb_s);
     }
-    const double g = m.GradientUnderTrain(s.x_mm) + c.gradient_error_x10;
-    const double a = braking_now ? -(c.beta_mm_s2 + grav * g) : amax - grav * g;
-    if (a < 0.0 && s.v_mm_s + a * dt <= 0.0) {
-      if (s.v_mm_s > 0.0) {
-        s.x_mm += s.v_mm_s * s.v_mm_s / (-2.0 * a);
-      }
-      s.v_mm_s = 0.0;  // standing (the brake holds; traction cannot hold it: no roll-back)
-    } else {
-      s.x_mm += s.v_mm_s * dt + 0.5 * a * dt * dt;
-      s.v_mm_s += a * dt;
-    }
+    const double grade = GradeDecel((m.GradientUnderTrain(s.x_mm) + c.gradient_error_x10) / 10.0, m.Gravity());
+    const double a = braking_now ? -(c.beta_mm_s2 + grade) : amax - grade;
+    // the offline train-motion model: a train that stops stands (the brake holds; traction
+    // cannot hold it on a rise: no roll-back)
+    const Motion next = Advance({s.x_mm, s.v_mm_s}, a, dt);
+    s.x_mm = next.position;
+    s.v_mm_s = next.speed;
     if (s.eb_s >= 0.0) {
       s.eb_s += dt;
     }
@@ -165,6 +161,20 @@ nlohmann::ordered_json StepJson(const AdversaryStep& c) {
           {"gradient_error_x10", c.gradient_error_x10},
           {"position_error_mm", c.position_error_mm},
           {"stale_mm", c.stale_mm}};
+}
+
+// The step of a regression case (the inverse of StepJson).
+AdversaryStep StepFromJson(const offline::JsonNode& st) {
+  AdversaryStep c;
+  c.cycles = static_cast<int>(st.Key("cycles").Int());
+  c.traction = st.Key("traction").Number();
+  c.speed_error = st.Key("speed_error").Number();
+  c.beta_mm_s2 = st.Key("beta_mm_s2").Number();
+  c.free_running_ms = st.Key("free_running_ms").Number();
+  c.gradient_error_x10 = st.Key("gradient_error_x10").Number();
+  c.position_error_mm = st.Key("position_error_mm").Number();
+  c.stale_mm = st.Key("stale_mm").Number();
+  return c;
 }
 
 std::mutex& OmplMutex() {
@@ -336,40 +346,23 @@ ReplayResult ReplayCase(const nlohmann::json& doc, const TrainType& train, const
   }
   ReplayResult r;
   r.max_overrun_mm = s.x_mm - static_cast<double>(env.l_mm);
-  for (const auto& st : root.Key("steps").Array()) {
-    AdversaryStep c;
-    c.cycles = static_cast<int>(st.Key("cycles").Int());
-    c.traction = st.Key("traction").Number();
-    c.speed_error = st.Key("speed_error").Number();
-    c.beta_mm_s2 = st.Key("beta_mm_s2").Number();
-    c.free_running_ms = st.Key("free_running_ms").Number();
-    c.gradient_error_x10 = st.Key("gradient_error_x10").Number();
-    c.position_error_mm = st.Key("position_error_mm").Number();
-    c.stale_mm = st.Key("stale_mm").Number();
-    c = Clamp(env, c);
+  const auto cycle = [&](const AdversaryStep& c) {
+    Cycle(env, s, c);
+    ++r.cycles;
+    r.max_overrun_mm = std::max(r.max_overrun_mm, s.x_mm - static_cast<double>(env.l_mm));
+  };
+  const auto steps = root.Key("steps").Array();
+  for (const auto& st : steps) {
+    const AdversaryStep c = Clamp(env, StepFromJson(st));
     for (int k = 0; k < c.cycles; ++k) {
-      Cycle(env, s, c);
-      ++r.cycles;
-      r.max_overrun_mm = std::max(r.max_overrun_mm, s.x_mm - static_cast<double>(env.l_mm));
+      cycle(c);
     }
   }
   // after the recorded controls: keep the last control until standstill (bounded)
-  const auto steps = root.Key("steps").Array();
   if (!steps.empty()) {
-    AdversaryStep c;
-    const auto& st = steps.back();
-    c.traction = st.Key("traction").Number();
-    c.speed_error = st.Key("speed_error").Number();
-    c.beta_mm_s2 = st.Key("beta_mm_s2").Number();
-    c.free_running_ms = st.Key("free_running_ms").Number();
-    c.gradient_error_x10 = st.Key("gradient_error_x10").Number();
-    c.position_error_mm = st.Key("position_error_mm").Number();
-    c.stale_mm = st.Key("stale_mm").Number();
-    c = Clamp(env, c);
+    const AdversaryStep c = Clamp(env, StepFromJson(steps.back()));
     for (int k = 0; k < 3000 && (s.v_mm_s > 0.0 || s.eb_s < 0.0); ++k) {
-      Cycle(env, s, c);
-      ++r.cycles;
-      r.max_overrun_mm = std::max(r.max_overrun_mm, s.x_mm - static_cast<double>(env.l_mm));
+      cycle(c);
       if (s.v_mm_s <= 0.0 && s.eb_s >= 0.0) {
         break;
       }

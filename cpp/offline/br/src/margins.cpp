@@ -11,6 +11,7 @@
 #include <string>
 
 #include "railproof/generated/mb_params.hpp"
+#include "railproof/offline/dynamics.hpp"
 
 namespace railproof::br::analysis {
 
@@ -145,13 +146,8 @@ MarginModel::MarginModel(const offline::RunningLine& rl, const TrainType& train,
   position_error_mm_ = (train.odometry_ppm * spacing + 999'999) / 1'000'000 + train.readhesion_margin_mm;
 
   // Runtime pattern calculator with the whole running line as its profile.
-  std::vector<br::GradientSegment> grads;
-  for (const auto& g : rl.gradients) {
-    grads.push_back({g.section.begin_mm, g.section.end_mm, g.permille_x10});
-  }
-  for (const auto& s : rl.speed_limits) {
-    restrictions_.push_back({s.section.begin_mm, s.section.end_mm, SpeedKmhToMmS(s.kmh)});
-  }
+  const std::vector<br::GradientSegment> grads = GradientProfile(rl);
+  restrictions_ = PermittedProfile(rl, 0);
   const std::size_t cap = std::max<std::size_t>({grads.size(), restrictions_.size(), 1}) + 1;
   auto created = br::PatternCalculator::Create(ToTrainData(train), params_, cap);
   if (created.error != br::CreateError::kNone) {
@@ -198,18 +194,22 @@ MarginModel::MarginModel(const offline::RunningLine& rl, const TrainType& train,
   for (const auto g : piece_g_) {
     g_low = std::min(g_low, g);
   }
-  const double ge = static_cast<double>(params_.gradient_error_x10);
-  const double grav = static_cast<double>(params_.gravity_mm_s2) / 10000.0;
-  const double v = static_cast<double>(train.MaxSpeedMmS());
+  const double grade = GradeDecel(static_cast<double>(g_low - params_.gradient_error_x10) / 10.0, Gravity());
   const double t = static_cast<double>(params_.cycle_ms + params_.reaction_ms + train.emergency_free_running_ms.max) / 1000.0;
-  const double a = static_cast<double>(train.accel_max_mm_s2) - grav * (static_cast<double>(g_low) - ge);
-  const double b = static_cast<double>(train.emergency_deceleration_mm_s2.min) + grav * (static_cast<double>(g_low) - ge);
+  const double b = static_cast<double>(train.emergency_deceleration_mm_s2.min) + grade;
   if (b <= 0.0) {
     throw offline::InputError(train.file + ": uncertainty.emergency_deceleration_mm_s2: the lowest real deceleration " +
                           "does not stop the train on the steepest falling gradient of running line " + rl.id);
   }
-  const double vb = v + a * t;
-  approach_mm_ = static_cast<std::int64_t>(std::ceil(v * t + 0.5 * a * t * t + vb * vb / (2.0 * b))) + 1000;
+  const Motion run_up = Advance({0.0, static_cast<double>(train.MaxSpeedMmS())},
+                                static_cast<double>(train.accel_max_mm_s2) - grade, t);
+  approach_mm_ = static_cast<std::int64_t>(std::ceil(run_up.position + StoppingDistance(run_up.speed, b, 0.0))) + 1000;
+}
+
+double MarginModel::Gravity() const { return static_cast<double>(params_.gravity_mm_s2); }
+
+double MarginModel::Grade(std::size_t piece, const Adversary& adv) const {
+  return GradeDecel((static_cast<double>(piece_g_[piece]) + adv.gradient_error_x10) / 10.0, Gravity());
 }
 
 double MarginModel::GradientUnderTrain(double front_mm) const {
@@ -271,103 +271,76 @@ std::optional<std::int64_t> MarginModel::MaxMeasuredSpeed(std::int64_t v_e) cons
   return v;
 }
 
-// Exact integration over the piecewise-constant gradient under the train.
+// Exact integration over the piecewise-constant gradient under the train (the offline
+// train-motion model, dynamics.hpp).
 Trajectory MarginModel::Simulate(double true_front_mm, double true_speed_mm_s, const Adversary& adv,
                                  bool keep_points) const {
   Trajectory tr;
   tr.true_front_mm = true_front_mm;
   tr.true_speed_mm_s = true_speed_mm_s;
   tr.adversary = adv;
-  const double grav = static_cast<double>(params_.gravity_mm_s2) / 10000.0;
   const double amax = static_cast<double>(train_.accel_max_mm_s2) * adv.traction;
   const double t_run = (adv.runup_cycle_ms + static_cast<double>(params_.reaction_ms) + adv.free_running_ms) / 1000.0;
   tr.run_up_ms = t_run * 1000.0;
-  double x = true_front_mm;
-  double v = std::max(0.0, true_speed_mm_s);
-  std::size_t k = static_cast<std::size_t>(std::upper_bound(piece_start_.begin(), piece_start_.end(), x) -
+  Motion m{true_front_mm, std::max(0.0, true_speed_mm_s)};
+  std::size_t k = static_cast<std::size_t>(std::upper_bound(piece_start_.begin(), piece_start_.end(), m.position) -
                                            piece_start_.begin()) - 1;
   const std::size_t n = piece_start_.size();
-  auto point = [&](double px, double pv) {
+  const auto piece_end = [&] { return k + 1 < n ? piece_start_[k + 1] : std::numeric_limits<double>::infinity(); };
+  auto point = [&](const Motion& p) {
     if (keep_points) {
-      tr.points.emplace_back(px, pv);
+      tr.points.emplace_back(p.position, p.speed);
     }
   };
-  point(x, v);
-  double t = 0.0;
-  while (t < t_run) {
-    const double g = static_cast<double>(piece_g_[k]) + adv.gradient_error_x10;
-    const double a = amax - grav * g;
-    const double end = k + 1 < n ? piece_start_[k + 1] : std::numeric_limits<double>::infinity();
-    const double dt = t_run - t;
-    if (a < 0.0 && v + a * dt <= 0.0) {
-      const double s = v * v / (-2.0 * a);
-      if (x + s <= end) {  // traction cannot hold the train on this rise: it stands
-        x += s;
-        v = 0.0;
-        t = t_run;
-        point(x, v);
-        break;
-      }
-    }
-    const double s_full = v * dt + 0.5 * a * dt * dt;
-    if (x + s_full <= end) {
+  point(m);
+  // run-up: traction against the gradient for t_run (a train that stops on a rise stands)
+  for (double t = 0.0; t < t_run;) {
+    const double a = amax - Grade(k, adv);
+    const double end = piece_end();
+    const Motion next = Advance(m, a, t_run - t);
+    if (next.position <= end) {
       if (keep_points) {
         for (int i = 1; i < 8; ++i) {
-          const double ti = dt * i / 8.0;
-          point(x + v * ti + 0.5 * a * ti * ti, v + a * ti);
+          point(Advance(m, a, (t_run - t) * i / 8.0));
         }
       }
-      x += s_full;
-      v += a * dt;
-      t = t_run;
-      point(x, v);
+      m = next;
+      point(m);
       break;
     }
-    const double d = end - x;
-    const double v_end = std::sqrt(std::max(0.0, v * v + 2.0 * a * d));
-    t += 2.0 * d / (v + v_end);
-    x = end;
-    v = v_end;
+    const double v_end = SpeedAfter(m.speed, a, end - m.position);
+    t += TimeOver(end - m.position, m.speed, v_end);
+    m = {end, v_end};
     ++k;
-    point(x, v);
+    point(m);
   }
-  tr.brake_front_mm = x;
-  tr.brake_speed_mm_s = v;
-  double w = v * v;
-  while (w > 0.0) {
-    const double g = static_cast<double>(piece_g_[k]) + adv.gradient_error_x10;
-    const double b = adv.beta_mm_s2 + grav * g;
-    const double end = k + 1 < n ? piece_start_[k + 1] : std::numeric_limits<double>::infinity();
-    if (b <= 0.0) {
-      if (std::isinf(end)) {  // never stops
-        x = std::numeric_limits<double>::infinity();
-        break;
-      }
-      w -= 2.0 * b * (end - x);
-      x = end;
-      ++k;
-      point(x, std::sqrt(w));
-      continue;
+  tr.brake_front_mm = m.position;
+  tr.brake_speed_mm_s = m.speed;
+  // braking with beta on the gradient until standstill
+  while (m.speed > 0.0) {
+    const double b = adv.beta_mm_s2 + Grade(k, adv);
+    const double end = piece_end();
+    if (b <= 0.0 && std::isinf(end)) {  // never stops
+      m.position = std::numeric_limits<double>::infinity();
+      break;
     }
-    const double s = w / (2.0 * b);
-    if (x + s <= end) {
+    const double s = b > 0.0 ? StoppingDistance(m.speed, b, 0.0) : std::numeric_limits<double>::infinity();
+    if (m.position + s <= end) {
       if (keep_points) {
         for (int i = 1; i < 16; ++i) {
           const double si = s * i / 16.0;
-          point(x + si, std::sqrt(std::max(0.0, w - 2.0 * b * si)));
+          point({m.position + si, SpeedAfter(m.speed, -b, si)});
         }
       }
-      x += s;
-      w = 0.0;
-      point(x, 0.0);
+      m = {m.position + s, 0.0};
+      point(m);
       break;
     }
-    w -= 2.0 * b * (end - x);
-    x = end;
+    m = {end, SpeedAfter(m.speed, -b, end - m.position)};
     ++k;
-    point(x, std::sqrt(std::max(0.0, w)));
+    point(m);
   }
-  tr.stop_mm = x;
+  tr.stop_mm = m.position;
   return tr;
 }
 

@@ -21,7 +21,6 @@
 #include <memory>
 #include <mutex>
 #include <optional>
-#include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
@@ -47,45 +46,6 @@ using Json = nlohmann::ordered_json;
 // error of the run-up, both well under 1 cm on the provided lines).
 constexpr double kCrossCheckTolMm = 50.0;
 
-void PrintHelp() {
-  std::printf(
-      "usage: margins --line FILE.json [--line ...] --train FILE.json [--train ...] --json OUT\n"
-      "               [--svg-dir DIR] [--cases-dir DIR] [--falsify-budget-s S] [--falsify-per-class N]\n"
-      "               [--nlp-per-class N | --nlp-all] [--resolution-mm R] [--threads N]\n"
-      "               [--compare-methods] [--quiet] [--help]\n"
-      "\n"
-      "Worst-case braking margins (REQ-BR-009/010/011/014): for every stop-limit location\n"
-      "(platform stop and fixed-block entry, route entrance, handover, system boundary, level\n"
-      "crossing, end of track; possession start and preceding-train rear at every virtual-block\n"
-      "boundary and gradient / speed-limit change +- train length) of every running line and\n"
-      "every train type, the minimum of L - worst stopping point over the uncertainty set and\n"
-      "every state the runtime supervision admits.\n"
-      "\n"
-      "  --line FILE           generated line JSON (build/gen/lines/<line>.json); repeatable\n"
-      "  --train FILE          train JSON (build/gen/trains/<name>.json); repeatable\n"
-      "  --json OUT            result JSON (requirements, verdict, minimum per line, train and\n"
-      "                        class, findings, statistics; with the per-location rows unless\n"
-      "                        --details is given)\n"
-      "  --details OUT         the per-location rows (worst states, adversary) in this file\n"
-      "  --svg-dir DIR         one SVG per line x running line x train: patterns and worst case\n"
-      "                        at the worst location of each class\n"
-      "  --cases-dir DIR       write falsifier violations as regression cases (JSON)\n"
-      "  --falsify-budget-s S  OMPL falsifier time per location (default 0.3; 0: off)\n"
-      "  --falsify-per-class N falsify the N worst locations per class (default 1)\n"
-      "  --nlp-per-class N     Ipopt on the N worst (grid) locations per class (default 2)\n"
-      "  --nlp-all             Ipopt on every location\n"
-      "  --resolution-mm R     grid step of the check position (default 1000)\n"
-      "  --threads N           worker threads of the grid (default: hardware)\n"
-      "  --compare-methods     time Ipopt against a continuous grid of equal accuracy\n"
-      "  --exclude-standstill-restart  judge only moving admissible states (NOT the design\n"
-      "                        note's definition: a standing train that restarts where V_e = 0\n"
-      "                        is admitted by the runtime; its margin is still reported)\n"
-      "  --quiet               no progress on stderr\n"
-      "\n"
-      "Exit status: 0 all margins >= 0 and all checks passed; 1 a negative margin (named),\n"
-      "a REQ-BR-010 finding, a falsifier violation or a failed NLP/grid cross-check; 2 bad input.\n");
-}
-
 struct Options {
   std::vector<std::string> lines;
   std::vector<std::string> trains;
@@ -97,49 +57,53 @@ struct Options {
   int nlp_per_class = 2;
   bool nlp_all = false;
   std::int64_t resolution_mm = 1000;
-  int threads = 0;
+  int threads = 0;  // 0: the hardware's
   bool compare = false;
   bool quiet = false;
   bool exclude_standstill = false;
   std::string details;  // per-location rows go here instead of into --json
 };
 
-// A number option's rule: [lo, hi], one message for a malformed or out-of-range value.
-railproof::offline::NumberRule InRange(double lo, double hi) {
-  return {.lo = lo,
-          .hi = hi,
-          .message = "{opt}: not a number in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]: '{value}'"};
-}
-
 Options ParseArgs(int argc, char** argv) {
+  namespace off = railproof::offline;
   Options o;
-  railproof::offline::CliParser cli({.tool = "margins", .unknown = railproof::offline::CliStyle::Unknown::kQuoted}, PrintHelp);
-  // The counts and the step accept any number in range, truncated toward zero (2.9 -> 2).
-  cli.List("--line", o.lines)
-      .List("--train", o.trains)
-      .Value("--json", o.json)
-      .Value("--details", o.details)
-      .Value("--svg-dir", o.svg_dir)
-      .Value("--cases-dir", o.cases_dir)
-      .Number("--falsify-budget-s", o.falsify_budget_s, InRange(0.0, 3600.0))
-      .Number("--falsify-per-class", [&](double v) { o.falsify_per_class = static_cast<int>(v); }, InRange(0, 1000))
-      .Number("--nlp-per-class", [&](double v) { o.nlp_per_class = static_cast<int>(v); }, InRange(0, 100000))
-      .Flag("--nlp-all", o.nlp_all)
-      .Number("--resolution-mm", [&](double v) { o.resolution_mm = static_cast<std::int64_t>(v); },
-              InRange(1, 100000))
-      .Number("--threads", [&](double v) { o.threads = static_cast<int>(v); }, InRange(1, 256))
-      .Flag("--compare-methods", o.compare)
-      .Flag("--exclude-standstill-restart", o.exclude_standstill)
-      .Flag("--quiet", o.quiet)
-      .Require("--line")
-      .Require("--train")
-      .Require("--json");
+  off::Cli cli("margins",
+               "Worst-case braking margins (REQ-BR-009/010/011/014): for every stop-limit location\n"
+               "(platform stop and fixed-block entry, route entrance, handover, system boundary, level\n"
+               "crossing, end of track; possession start and preceding-train rear at every virtual-block\n"
+               "boundary and gradient / speed-limit change +- train length) of every running line and\n"
+               "every train type, the minimum of L - worst stopping point over the uncertainty set and\n"
+               "every state the runtime supervision admits.",
+               "Exit status: 0 all margins >= 0 and all checks passed; 1 a negative margin (named),\n"
+               "a REQ-BR-010 finding, a falsifier violation or a failed NLP/grid cross-check; 2 bad input.");
+  cli.Add("--line", o.lines, "generated line JSON (build/gen/lines/<line>.json); repeatable")->required();
+  cli.Add("--train", o.trains, "train JSON (build/gen/trains/<name>.json); repeatable")->required();
+  cli.Add("--json", o.json,
+          "result JSON (requirements, verdict, minimum per line, train and class, findings,\n"
+          "statistics; with the per-location rows unless --details is given)")
+      ->required();
+  cli.Add("--details", o.details, "the per-location rows (worst states, adversary) in this file");
+  cli.Add("--svg-dir", o.svg_dir,
+          "one SVG per line x running line x train: patterns and worst case at the worst\n"
+          "location of each class");
+  cli.Add("--cases-dir", o.cases_dir, "write falsifier violations as regression cases (JSON)");
+  cli.Add("--falsify-budget-s", o.falsify_budget_s, "OMPL falsifier time per location (0: off)")
+      ->check(off::InRange(0.0, 3600.0));
+  cli.Add("--falsify-per-class", o.falsify_per_class, "falsify the N worst locations per class")
+      ->check(off::InRange(0, 1000));
+  cli.Add("--nlp-per-class", o.nlp_per_class, "Ipopt on the N worst (grid) locations per class")
+      ->check(off::InRange(0, 100000));
+  cli.Add("--nlp-all", o.nlp_all, "Ipopt on every location");
+  cli.Add("--resolution-mm", o.resolution_mm, "grid step of the check position")->check(off::InRange(1, 100000));
+  cli.Add("--threads", o.threads, "worker threads of the grid (default: the hardware's)")->check(off::InRange(1, 256));
+  cli.Add("--compare-methods", o.compare, "time Ipopt against a continuous grid of equal accuracy");
+  cli.Add("--exclude-standstill-restart", o.exclude_standstill,
+          "judge only moving admissible states (NOT the design note's definition: a\n"
+          "standing train that restarts where V_e = 0 is admitted by the runtime; its margin is\n"
+          "still reported)");
+  cli.Add("--quiet", o.quiet, "no progress on stderr");
   cli.ParseOrExit(argc, argv);
   return o;
-}
-
-void WriteFile(const std::filesystem::path& path, const std::string& text) {
-  railproof::offline::WriteFileAtomic(path, text);
 }
 
 struct Row {
@@ -187,10 +151,12 @@ Json TrajJson(const an::Trajectory& t) {
 double Round3(double v) { return std::round(v * 1000.0) / 1000.0; }
 
 std::string Svg(const Job& job, const std::map<int, std::size_t>& worst_by_class) {
+  using railproof::offline::SvgPlot;
+  using railproof::offline::SvgStyle;
   const auto& m = *job.model;
   const auto& calc = m.patterns();
   const std::int64_t e = m.position_error_mm();
-  std::vector<std::string> parts;
+  std::vector<SvgPlot> panels;
   for (const auto& [cls, idx] : worst_by_class) {
     const Row& r = job.rows[idx];
     const double l = static_cast<double>(r.loc.stop_limit_mm);
@@ -199,7 +165,7 @@ std::string Svg(const Job& job, const std::map<int, std::size_t>& worst_by_class
     const double x_lo = -d / 1000.0;
     const double x_hi = std::max(30.0, static_cast<double>(r.loc.class_margin_mm) / 1000.0 + 10.0) + over / 1000.0;
     double v_top = 0.0;
-    std::vector<std::pair<double, double>> ve, vs;
+    railproof::offline::SvgPoints ve, vs;
     for (std::int64_t x = r.loc.stop_limit_mm - m.approach_mm(); x <= r.loc.stop_limit_mm; x += 1000) {
       const double px = (static_cast<double>(x) - l) / 1000.0;
       const double a = static_cast<double>(calc.EmergencyPatternSpeed(x, r.loc.stop_limit_mm, e, e)) * 0.0036;
@@ -208,13 +174,13 @@ std::string Svg(const Job& job, const std::map<int, std::size_t>& worst_by_class
       vs.emplace_back(px, b);
     }
     const an::Trajectory& w = r.method == "nlp" && r.nlp ? r.nlp->worst : r.grid.worst;
-    std::vector<std::pair<double, double>> tr;
+    railproof::offline::SvgPoints tr;
     for (const auto& [x, v] : w.points) {
       tr.emplace_back((x - l) / 1000.0, v * 0.0036);
       v_top = std::max(v_top, v * 0.0036);
     }
     v_top = std::max(v_top, static_cast<double>(m.train_max_speed_mm_s()) * 0.0036 + 10.0);
-    railproof::offline::SvgPlot plot(x_lo, x_hi, 0.0, v_top);
+    SvgPlot& plot = panels.emplace_back(x_lo, x_hi, 0.0, v_top);
     char title[512];
     std::snprintf(title, sizeof title, "%s / %s / %s — %s: %s, margin %.3f m (%s)", job.line->name.c_str(),
                   job.rl->id.c_str(), job.train->name.c_str(), an::ToString(r.loc.cls), r.loc.id.c_str(),
@@ -222,40 +188,21 @@ std::string Svg(const Job& job, const std::map<int, std::size_t>& worst_by_class
     plot.SetTitle(title);
     plot.SetXLabel("front position relative to the stop limit L (m)");
     plot.SetYLabel("speed (km/h)");
-    railproof::offline::SvgStyle se{"#c00000", 2.0, "", 1.0};
-    railproof::offline::SvgStyle ss{"#0060c0", 2.0, "6 4", 1.0};
-    railproof::offline::SvgStyle st{"#000000", 2.5, "", 1.0};
-    railproof::offline::SvgStyle sl{"#808080", 1.0, "3 3", 1.0};
-    plot.AddPolyline(ve, se);
-    plot.AddPolyline(vs, ss);
-    plot.AddPolyline(tr, st);
-    plot.AddPolyline({{0.0, 0.0}, {0.0, v_top}}, sl);
-    const double ob = static_cast<double>(r.loc.class_margin_mm) / 1000.0;
-    plot.AddPolyline({{ob, 0.0}, {ob, v_top}}, railproof::offline::SvgStyle{"#800080", 1.0, "3 3", 1.0});
+    const SvgStyle limit{"#808080", 1.0, "3 3", 1.0};
+    const SvgStyle obstruction{"#800080", 1.0, "3 3", 1.0};
+    plot.AddSeries(ve, SvgStyle{"#c00000", 2.0, "", 1.0}, "emergency pattern V_e (runtime, at x_s)");
+    plot.AddSeries(vs, SvgStyle{"#0060c0", 2.0, "6 4", 1.0}, "service pattern V_s (runtime, at x_s)");
+    plot.AddSeries(tr, SvgStyle{"#000000", 2.5, "", 1.0}, "worst-case true trajectory");
+    plot.AddVLine(0.0, "", limit);
+    plot.AddVLine(static_cast<double>(r.loc.class_margin_mm) / 1000.0, "", obstruction);
     if (!tr.empty()) {
       plot.AddMarker(tr.front().first, tr.front().second, "#000000", "check");
       plot.AddMarker(tr.back().first, 0.0, r.margin_mm < 0 ? "#ff0000" : "#008000", "stop");
     }
-    plot.AddLegend("emergency pattern V_e (runtime, at x_s)", se);
-    plot.AddLegend("service pattern V_s (runtime, at x_s)", ss);
-    plot.AddLegend("worst-case true trajectory", st);
-    plot.AddLegend("stop limit L", sl);
-    plot.AddLegend("obstruction (L + class margin)", railproof::offline::SvgStyle{"#800080", 1.0, "3 3", 1.0});
-    std::string svg = plot.Render();
-    const auto pos = svg.find("<svg");
-    parts.push_back(svg.substr(pos));
+    plot.AddLegend("stop limit L", limit);
+    plot.AddLegend("obstruction (L + class margin)", obstruction);
   }
-  std::ostringstream o;
-  const double h = 860.0;
-  o << "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"1560\" height=\""
-    << h * static_cast<double>(parts.size()) << "\">\n";
-  for (std::size_t i = 0; i < parts.size(); ++i) {
-    std::string p = parts[i];
-    p.replace(0, 4, "<svg y=\"" + std::to_string(static_cast<int>(h * static_cast<double>(i))) + "\"");
-    o << p << "\n";
-  }
-  o << "</svg>\n";
-  return o.str();
+  return railproof::offline::SvgStack(panels);
 }
 
 int Main(int argc, char** argv) {
@@ -426,7 +373,7 @@ int Main(int argc, char** argv) {
             std::filesystem::create_directories(o.cases_dir);
             std::string name = job.line->name + "_" + job.rl->id + "_" + job.train->name + "_" + an::ToString(row.loc.cls) + "_" +
                                std::to_string(row.loc.stop_limit_mm) + ".json";
-            WriteFile(std::filesystem::path(o.cases_dir) / name, row.fals->regression_case.dump(1) + "\n");
+            railproof::offline::WriteFileAtomic(std::filesystem::path(o.cases_dir) / name, row.fals->regression_case.dump(1) + "\n");
           }
         }
       }
@@ -544,7 +491,7 @@ int Main(int argc, char** argv) {
     }
     if (!o.svg_dir.empty()) {
       std::filesystem::create_directories(o.svg_dir);
-      WriteFile(std::filesystem::path(o.svg_dir) / (job.line->name + "_" + job.rl->id + "_" + job.train->name + ".svg"),
+      railproof::offline::WriteFileAtomic(std::filesystem::path(o.svg_dir) / (job.line->name + "_" + job.rl->id + "_" + job.train->name + ".svg"),
                 Svg(job, worst_by_class));
     }
   }
@@ -593,9 +540,9 @@ int Main(int argc, char** argv) {
   } else {
     out["details"] = std::filesystem::path(o.details).filename().string();
     const Json details{{"schema", "railproof/margins-details/1"}, {"skipped", skipped}, {"rows", rows}};
-    WriteFile(o.details, details.dump(1) + "\n");
+    railproof::offline::WriteFileAtomic(o.details, details.dump(1) + "\n");
   }
-  WriteFile(o.json, out.dump(1) + "\n");
+  railproof::offline::WriteFileAtomic(o.json, out.dump(1) + "\n");
   std::printf("%zu location x train rows (%zu skipped near the line start), grid %.1f s, %zu NLP %.1f s, %zu falsifier %.1f s (%zu violation(s)); total %.1f s: %s\n",
               tasks.size(), skipped_total, grid_wall, nlp_runs, nlp_wall, fals_runs, fals_wall, fals_found, wall,
               pass ? "PASS" : "FAIL");
@@ -617,13 +564,5 @@ int Main(int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  try {
-    return Main(argc, argv);
-  } catch (const InputError& e) {
-    std::fprintf(stderr, "margins: %s\n", e.what());
-    return 2;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "margins: error: %s\n", e.what());
-    return 2;
-  }
+  return railproof::offline::RunTool("margins", [&] { return Main(argc, argv); });
 }

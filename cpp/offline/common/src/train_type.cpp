@@ -1,6 +1,7 @@
 // Train type loader for the offline braking analysis (train_type.hpp).
 #include "railproof/offline/train_type.hpp"
 
+#include <algorithm>
 #include <fstream>
 #include <sstream>
 #include <string>
@@ -142,6 +143,26 @@ std::vector<std::string> DesignRuleFindings(const TrainType& t) {
   if (t.service_pattern_mm_s2 > t.emergency_pattern_mm_s2) {
     out.push_back(t.file + ": braking.service_pattern_mm_s2: beta_n7 " + std::to_string(t.service_pattern_mm_s2) +
                   " mm/s^2 exceeds beta_e " + std::to_string(t.emergency_pattern_mm_s2) + " mm/s^2 (REQ-BR-010)");
+  }
+  return out;
+}
+
+std::vector<br::GradientSegment> GradientProfile(const RunningLine& rl) {
+  std::vector<br::GradientSegment> out;
+  for (const auto& g : rl.gradients) {
+    out.push_back({g.section.begin_mm, g.section.end_mm, g.permille_x10});
+  }
+  return out;
+}
+
+std::vector<br::RestrictionSegment> PermittedProfile(const RunningLine& rl, std::int64_t cap_mm_s) {
+  std::vector<br::RestrictionSegment> out;
+  for (const auto& s : rl.speed_limits) {
+    std::int64_t v = SpeedKmhToMmS(s.kmh);
+    if (cap_mm_s > 0) {
+      v = std::min(v, cap_mm_s);
+    }
+    out.push_back({s.section.begin_mm, s.section.end_mm, v});
   }
   return out;
 }

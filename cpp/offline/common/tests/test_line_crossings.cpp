@@ -4,7 +4,6 @@
 // min_warning_time_ms and overlapping crossings, naming the file, the crossing and the reason.
 #include <gtest/gtest.h>
 
-#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -15,20 +14,13 @@
 
 #include "railproof/generated/lc_params.hpp"
 #include "railproof/offline/line.hpp"
+#include "railproof/testing/gen_data.hpp"
+#include "railproof/testing/input_error.hpp"
 
 namespace railproof::offline {
 namespace {
 
-std::filesystem::path GenLinesDir() {
-  if (const char* env = std::getenv("RAILPROOF_GEN_DIR")) {
-    return std::filesystem::path(env) / "lines";
-  }
-#if defined(RAILPROOF_TEST_GEN_DIR)
-  return std::filesystem::path(RAILPROOF_TEST_GEN_DIR) / "lines";
-#else
-  return std::filesystem::path(RAILPROOF_TEST_GEN_DIR) / "lines";
-#endif
-}
+std::filesystem::path GenLinesDir() { return testing::GenDir() / "lines"; }
 
 nlohmann::json D4Json() {
   std::ifstream in(GenLinesDir() / "d4_local_line.json");
@@ -41,17 +33,7 @@ nlohmann::json& FirstCrossing(nlohmann::json& j) { return j["running_lines"][0][
 void ExpectCrossingError(const std::function<void(nlohmann::json&)>& mutate, const std::vector<std::string>& fragments) {
   nlohmann::json j = D4Json();
   mutate(j);
-  try {
-    (void)ParseLine(j.dump(), "bad_line.json");
-    ADD_FAILURE() << "no error for " << fragments.front();
-  } catch (const InputError& e) {
-    const std::string msg = e.what();
-    EXPECT_EQ(msg.rfind("bad_line.json: ", 0), 0U) << msg;
-    EXPECT_EQ(msg.find('\n'), std::string::npos) << "one line: " << msg;
-    for (const auto& f : fragments) {
-      EXPECT_NE(msg.find(f), std::string::npos) << "'" << f << "' not in: " << msg;
-    }
-  }
+  testing::ExpectInputError([&] { (void)ParseLine(j.dump(), "bad_line.json"); }, "bad_line.json", fragments);
 }
 
 // @verifies REQ-LC-016

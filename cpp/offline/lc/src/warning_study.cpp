@@ -15,6 +15,7 @@
 #include "railproof/br/supervisor.hpp"
 #include "railproof/generated/lc_params.hpp"
 #include "railproof/lc/onboard/crossing_protection.hpp"
+#include "railproof/offline/dynamics.hpp"
 
 namespace railproof::lc::analysis {
 
@@ -22,18 +23,6 @@ using offline::InputError;
 namespace lcp = railproof::params::lc;
 
 // ============================================================================ kinematics
-
-std::vector<br::RestrictionSegment> PermittedProfile(const offline::RunningLine& rl, std::int64_t cap_mm_s) {
-  std::vector<br::RestrictionSegment> out;
-  for (const auto& s : rl.speed_limits) {
-    std::int64_t v = SpeedKmhToMmS(s.kmh);
-    if (cap_mm_s > 0) {
-      v = std::min(v, cap_mm_s);
-    }
-    out.push_back({s.section.begin_mm, s.section.end_mm, v});
-  }
-  return out;
-}
 
 // @implements REQ-LC-017
 std::int64_t TreadleDistanceMm(std::span<const br::RestrictionSegment> profile, std::int64_t near_mm,
@@ -86,21 +75,20 @@ namespace {
 // Lowest line limit (mm/s) over the train [x - length, x], capped at the train's maximum speed.
 double PermittedRear(const offline::RunningLine& rl, double x, const SectionDriving& d) {
   std::int64_t v = d.max_speed_mm_s > 0 ? d.max_speed_mm_s : std::numeric_limits<std::int64_t>::max();
-  const double lo = x - static_cast<double>(d.train_length_mm);
   double c = std::numeric_limits<double>::infinity();
-  for (std::size_t i = 0; i < rl.speed_limits.size(); ++i) {
-    const auto& s = rl.speed_limits[i];
-    if (static_cast<double>(s.section.end_mm) > lo && static_cast<double>(s.section.begin_mm) <= x) {
-      v = std::min(v, SpeedKmhToMmS(s.kmh));
-      if (d.ceiling_mm_s != nullptr && i < d.ceiling_mm_s->size()) {
-        c = std::min(c, (*d.ceiling_mm_s)[i]);
-      }
+  rl.ForEachLimitActing(x - static_cast<double>(d.train_length_mm), x, [&](std::size_t i) {
+    v = std::min(v, SpeedKmhToMmS(rl.speed_limits[i].kmh));
+    if (d.ceiling_mm_s != nullptr && i < d.ceiling_mm_s->size()) {
+      c = std::min(c, (*d.ceiling_mm_s)[i]);
     }
-  }
+  });
   return std::min(static_cast<double>(v), c);
 }
 
 constexpr std::int64_t kGridMm = 1000;  // position grid of the kinematic model (1 m)
+
+// The constant acceleration (mm/s^2) between two samples of a run.
+double Acceleration(const RunSample& a, const RunSample& b) { return (b.v_mm_s - a.v_mm_s) / ((b.t_ms - a.t_ms) / 1000.0); }
 
 }  // namespace
 
@@ -124,18 +112,18 @@ double RunSection(const offline::RunningLine& rl, std::int64_t from_mm, std::int
   }
   v[0] = 0.0;
   for (std::size_t i = 0; i + 1 < n; ++i) {  // accelerate at accel_max
-    v[i + 1] = std::min(v[i + 1], std::sqrt(v[i] * v[i] + 2.0 * d.accel_mm_s2 * (x[i + 1] - x[i])));
+    v[i + 1] = std::min(v[i + 1], SpeedAfter(v[i], d.accel_mm_s2, x[i + 1] - x[i]));
   }
   v[n - 1] = 0.0;
-  for (std::size_t i = n - 1; i > 0; --i) {  // brake at the service deceleration
-    v[i - 1] = std::min(v[i - 1], std::sqrt(v[i] * v[i] + 2.0 * d.decel_mm_s2 * (x[i] - x[i - 1])));
+  for (std::size_t i = n - 1; i > 0; --i) {  // brake at the service deceleration (backwards)
+    v[i - 1] = std::min(v[i - 1], SpeedAfter(v[i], d.decel_mm_s2, x[i] - x[i - 1]));
   }
   double t = 0.0;
   if (out != nullptr) {
     out->push_back({t0_ms, x[0], 0.0});
   }
   for (std::size_t i = 0; i + 1 < n; ++i) {
-    t += 2000.0 * (x[i + 1] - x[i]) / (v[i] + v[i + 1]);
+    t += TimeOver(1000.0 * (x[i + 1] - x[i]), v[i], v[i + 1]);  // ms: 1000 x mm / (mm/s)
     if (out != nullptr) {
       out->push_back({t0_ms + t, x[i + 1], v[i + 1]});
     }
@@ -157,20 +145,10 @@ std::optional<double> Run::TimeAt(double x_mm) const {
   if (b.x_mm <= a.x_mm) {
     return b.t_ms;
   }
-  // constant acceleration between the grid points: solve x(t) = x_mm
+  // constant acceleration between the grid points
   const double dt = b.t_ms - a.t_ms;
-  const double acc = (b.v_mm_s - a.v_mm_s) / dt;  // mm/s per ms
-  const double dx = x_mm - a.x_mm;
-  double tau = 0.0;
-  if (std::fabs(acc) < 1e-12) {
-    tau = dx / (a.v_mm_s / 1000.0);
-  } else {
-    // dx = v_a tau / 1000 + acc tau^2 / 2000
-    const double A = acc / 2000.0, B = a.v_mm_s / 1000.0;
-    const double disc = std::max(0.0, B * B + 4.0 * A * dx);
-    tau = (-B + std::sqrt(disc)) / (2.0 * A);
-  }
-  return a.t_ms + std::clamp(tau, 0.0, dt);
+  const double tau_ms = 1000.0 * TimeToCover(a.v_mm_s, Acceleration(a, b), x_mm - a.x_mm);
+  return a.t_ms + std::clamp(tau_ms, 0.0, dt);
 }
 
 RunSample Run::StateAt(double t_ms) const {
@@ -191,11 +169,8 @@ RunSample Run::StateAt(double t_ms) const {
   if (dt <= 0.0 || b.x_mm <= a.x_mm) {
     return {t_ms, a.x_mm, 0.0};
   }
-  const double tau = t_ms - a.t_ms;
-  const double acc = (b.v_mm_s - a.v_mm_s) / dt;
-  const double v = a.v_mm_s + acc * tau;
-  const double x = a.x_mm + a.v_mm_s * tau / 1000.0 + acc * tau * tau / 2000.0;
-  return {t_ms, std::min(x, b.x_mm), std::max(0.0, v)};
+  const Motion m = Advance({a.x_mm, a.v_mm_s}, Acceleration(a, b), (t_ms - a.t_ms) / 1000.0);
+  return {t_ms, std::min(m.position, b.x_mm), m.speed};
 }
 
 std::optional<std::size_t> Run::StandingAt(double t_ms) const {
@@ -736,12 +711,7 @@ StudyResult RunStudy(const StudyInputs& in, const std::function<void(std::size_t
         throw InputError(s.train->file + ": braking patterns refused the train: " + br::ToString(created.error));
       }
       pc->calc.emplace(std::move(*created.calculator));
-      std::vector<br::GradientSegment> g;
-      for (const auto& x : s.rl->gradients) {
-        g.push_back({x.section.begin_mm, x.section.end_mm, x.permille_x10});
-      }
-      std::vector<br::RestrictionSegment> lim = PermittedProfile(*s.rl, 0);
-      const auto pr = pc->calc->SetProfile(g, lim);
+      const auto pr = pc->calc->SetProfile(GradientProfile(*s.rl), PermittedProfile(*s.rl, 0));
       if (pr.verdict != br::ProfileVerdict::kAccept) {
         throw InputError(line.file + ": running line " + s.rl->id + ": braking profile refused: " + br::ToString(pr.verdict));
       }

@@ -366,11 +366,10 @@ std::string HistogramSvg(const StudyResult& r, Method m, const std::string& line
   }
   const offline::SvgStyle design{"#c00000", 1.5, "6 4", 1.0};
   for (std::int64_t d : designs) {
-    const double x = static_cast<double>(d) / 1000.0;
-    plot.AddPolyline({{x, 0.0}, {x, ymax}}, design);
+    plot.AddVLine(static_cast<double>(d) / 1000.0, "", design);
   }
-  plot.AddLegend("stopping services", offline::SvgStyle{"#e08020", 8.0, "", 0.9}, true);
-  plot.AddLegend("fast services", offline::SvgStyle{"#2060c0", 8.0, "", 0.9}, true);
+  plot.AddLegend("stopping services", offline::SvgStyle{"#e08020", 8.0, "", 0.9}, offline::SvgPlot::LegendKind::kBox);
+  plot.AddLegend("fast services", offline::SvgStyle{"#2060c0", 8.0, "", 0.9}, offline::SvgPlot::LegendKind::kBox);
   plot.AddLegend("design warning times", design);
   return plot.Render();
 }

@@ -8,16 +8,14 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
-#include <exception>
 #include <filesystem>
 #include <map>
 #include <string>
-#include <string_view>
 #include <vector>
 
 #include "railproof/offline/train_type.hpp"
 #include "railproof/lc/analysis/warning_study.hpp"
+#include "railproof/offline/cli.hpp"
 #include "railproof/offline/line.hpp"
 #include "railproof/offline/output_file.hpp"
 
@@ -26,94 +24,43 @@ namespace {
 namespace an = railproof::lc::analysis;
 using railproof::offline::InputError;
 
-void PrintHelp() {
-  std::printf(
-      "usage: warning_study --line FILE.json --timetable FILE.json --trains-dir DIR --json OUT.json\n"
-      "                     [--svg-dir DIR] [--lead-sweep S,S,...] [--quiet] [--help]\n"
-      "\n"
-      "Warning-time study of level crossings (REQ-LC-017, also REQ-LC-002/005/008/015). Every\n"
-      "service of the timetable is simulated on the line (kinematic model, seeded driver\n"
-      "variation); for every crossing it passes, the warning time (arrival at the near edge\n"
-      "minus warning start) is computed for fixed treadles, the on-board request (runtime\n"
-      "lc::onboard::CrossingProtection: without and with dwell awareness, and dwell-aware from the\n"
-      "approach on) and GNSS-time pre-arming; trains the protection pattern would brake are\n"
-      "counted (runtime braking patterns and supervision).\n"
-      "\n"
-      "  --line FILE        generated line JSON (build/gen/lines/<line>.json)\n"
-      "  --timetable FILE   generated timetable JSON (build/gen/timetables/<name>.json)\n"
-      "  --trains-dir DIR   generated train JSON (build/gen/trains)\n"
-      "  --json OUT         result JSON (requirements, per-method statistics, requirement rows,\n"
-      "                     per-crossing rows with meets_target, every passage)\n"
-      "  --svg-dir DIR      one histogram per method: warning_time_<method>.svg\n"
-      "  --lead-sweep S,..  also run the on-board methods with these request leads (s) and\n"
-      "                     report trains braked and warning times per lead (sensitivity of\n"
-      "                     REQ-LC-015 to request_lead_ms; informational)\n"
-      "  --quiet            no progress on stderr\n"
-      "\n"
-      "Exit status: 0 pass; 1 a warning of an on-board or GNSS-time method below the design\n"
-      "warning time, or a train braked by the protection pattern (named on stderr); 2 bad input.\n");
-}
-
-[[noreturn]] void Usage(const std::string& reason) {
-  std::fprintf(stderr, "warning_study: %s (see --help)\n", reason.c_str());
-  std::exit(2);
-}
-
 struct Options {
   std::string line, timetable, trains_dir, json, svg_dir;
-  std::vector<std::int64_t> lead_sweep_ms;
+  std::vector<double> lead_sweep_s;
   bool quiet = false;
 };
 
 Options ParseArgs(int argc, char** argv) {
+  namespace off = railproof::offline;
   Options o;
-  for (int i = 1; i < argc; ++i) {
-    const std::string_view a = argv[i];
-    auto value = [&]() -> std::string {
-      if (i + 1 >= argc) {
-        Usage(std::string(a) + " needs a value");
-      }
-      return argv[++i];
-    };
-    if (a == "--help" || a == "-h") {
-      PrintHelp();
-      std::exit(0);
-    } else if (a == "--line") {
-      o.line = value();
-    } else if (a == "--timetable") {
-      o.timetable = value();
-    } else if (a == "--trains-dir") {
-      o.trains_dir = value();
-    } else if (a == "--json") {
-      o.json = value();
-    } else if (a == "--svg-dir") {
-      o.svg_dir = value();
-    } else if (a == "--lead-sweep") {
-      const std::string v = value();
-      std::size_t pos = 0;
-      while (pos <= v.size()) {
-        const std::size_t comma = std::min(v.find(',', pos), v.size());
-        const std::string item = v.substr(pos, comma - pos);
-        char* end = nullptr;
-        const double sec = std::strtod(item.c_str(), &end);
-        if (item.empty() || end != item.c_str() + item.size() || !(sec >= 0.0 && sec <= 600.0)) {
-          Usage("--lead-sweep: not a list of seconds in [0, 600]: '" + v + "'");
-        }
-        o.lead_sweep_ms.push_back(static_cast<std::int64_t>(std::llround(sec * 1000.0)));
-        pos = comma + 1;
-      }
-    } else if (a == "--quiet") {
-      o.quiet = true;
-    } else {
-      Usage("unknown option '" + std::string(a) + "'");
-    }
-  }
-  for (const auto& [v, name] : {std::pair{o.line, "--line"}, std::pair{o.timetable, "--timetable"},
-                                std::pair{o.trains_dir, "--trains-dir"}, std::pair{o.json, "--json"}}) {
-    if (v.empty()) {
-      Usage(std::string(name) + " is required");
-    }
-  }
+  off::Cli cli("warning_study",
+               "Warning-time study of level crossings (REQ-LC-017, also REQ-LC-002/005/008/015). Every\n"
+               "service of the timetable is simulated on the line (the offline train-motion model\n"
+               "without gradients, seeded driver variation); for every crossing it passes, the\n"
+               "warning time (arrival at the near edge minus warning start) is computed for fixed\n"
+               "treadles, the on-board request (runtime lc::onboard::CrossingProtection: without and\n"
+               "with dwell awareness, and dwell-aware from the approach on) and GNSS-time pre-arming;\n"
+               "trains the protection pattern would brake are counted (runtime braking patterns and\n"
+               "supervision).",
+               "Exit status: 0 pass; 1 a warning of an on-board or GNSS-time method below the design\n"
+               "warning time, or a train braked by the protection pattern (named on stderr); 2 bad input.");
+  cli.Add("--line", o.line, "generated line JSON (build/gen/lines/<line>.json)")->required();
+  cli.Add("--timetable", o.timetable, "generated timetable JSON (build/gen/timetables/<name>.json)")
+      ->required();
+  cli.Add("--trains-dir", o.trains_dir, "generated train JSON (build/gen/trains)")->required();
+  cli.Add("--json", o.json,
+          "result JSON (requirements, per-method statistics, requirement rows, per-crossing rows\n"
+          "with meets_target, every passage)")
+      ->required();
+  cli.Add("--svg-dir", o.svg_dir, "one histogram per method: warning_time_<method>.svg");
+  cli.Add("--lead-sweep", o.lead_sweep_s,
+          "also run the on-board methods with these request leads (s, comma-separated) and\n"
+          "report trains braked and warning times per lead (sensitivity of REQ-LC-015 to\n"
+          "request_lead_ms; informational)")
+      ->delimiter(',')
+      ->check(off::InRange(0.0, 600.0));
+  cli.Add("--quiet", o.quiet, "no progress on stderr");
+  cli.ParseOrExit(argc, argv);
   return o;
 }
 
@@ -140,9 +87,10 @@ int Main(int argc, char** argv) {
     }
   });
   auto json = an::StudyJson(in, r, 0.0);
-  if (!o.lead_sweep_ms.empty()) {
+  if (!o.lead_sweep_s.empty()) {
     nlohmann::ordered_json rows = nlohmann::ordered_json::array();
-    for (const std::int64_t lead : o.lead_sweep_ms) {
+    for (const double lead_s : o.lead_sweep_s) {
+      const auto lead = static_cast<std::int64_t>(std::llround(lead_s * 1000.0));
       an::StudyInputs li = in;
       li.request_lead_ms = lead;
       const an::StudyResult lr = an::RunStudy(li);
@@ -198,13 +146,5 @@ int Main(int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  try {
-    return Main(argc, argv);
-  } catch (const InputError& e) {
-    std::fprintf(stderr, "warning_study: %s\n", e.what());
-    return 2;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "warning_study: error: %s\n", e.what());
-    return 2;
-  }
+  return railproof::offline::RunTool("warning_study", [&] { return Main(argc, argv); });
 }

@@ -47,40 +47,6 @@ namespace fs = std::filesystem;
 using railproof::offline::InputError;
 using Json = nlohmann::ordered_json;
 
-void PrintHelp() {
-  std::printf(
-      "usage: odometry_study --scenarios DIR|FILE --out-dir DIR [--json FILE] [--trains-dir DIR]\n"
-      "                      [--lines-dir DIR] [--only NAME]... [--cycles-dir DIR] [--threads N]\n"
-      "                      [--quiet] [--help]\n"
-      "\n"
-      "Offline odometry study (REQ-RA-003..010, REQ-RA-014; D1 §3 items 6-9, D1 §5.2).\n"
-      "Every scenario (schema railproof/wheelrail-scenario/1) is simulated and replayed with the\n"
-      "IMU method (configured start points), with one start point and with the former\n"
-      "max/min-acceleration method. Checks: the true distance error at re-adhesion of every\n"
-      "compensation of the configured method within the error bound (ratio <= 1); the true\n"
-      "front inside the reported envelope in every cycle with a valid position (both IMU\n"
-      "runs); scenarios with expect_safe_reaction end in a maximum-time stop; sensor faults\n"
-      "give the typed rejection and stop reason; every train type's readhesion_margin_mm\n"
-      "covers the error model at %lld ms, %.4f deg/s and the steepest gradient of its line.\n"
-      "\n"
-      "  --scenarios DIR|FILE  scenario JSON files (every *.json of DIR, sorted)\n"
-      "  --out-dir DIR         per scenario <name>.svg (panels) and <name>.events.json; the summary\n"
-      "                        plots margin_vs_compensation_time.svg and clearing_time_cost.svg\n"
-      "  --json FILE           result JSON (requirements, verdict, worst_bound_ratio, scenarios,\n"
-      "                        slip/slide phases, episodes, start-point and baseline comparison,\n"
-      "                        checks, margin and clearing-time tables, train margins)\n"
-      "  --trains-dir DIR      generated train JSON (default build/gen/trains)\n"
-      "  --lines-dir DIR       generated line JSON (default build/gen/lines)\n"
-      "  --only NAME           only this scenario (file stem); repeatable\n"
-      "  --cycles-dir DIR      also write every cycle of the three runs as <name>.<run>.csv\n"
-      "                        (truth, output, machine state; for diagnosis)\n"
-      "  --threads N           scenarios simulated in parallel (default 1)\n"
-      "  --quiet               no progress on stderr\n"
-      "\n"
-      "Exit status: 0 pass, 1 a check failed (named on stderr), 2 bad input or error.\n",
-      static_cast<long long>(rp::max_compensation_ms), static_cast<double>(rp::imu_rate_error_udeg_s) / 1e6);
-}
-
 struct Options {
   std::string scenarios;
   std::string out_dir;
@@ -94,19 +60,38 @@ struct Options {
 };
 
 Options ParseArgs(int argc, char** argv) {
+  namespace off = railproof::offline;
   Options o;
-  railproof::offline::CliParser cli({.tool = "odometry_study"}, PrintHelp);
-  cli.Value("--scenarios", o.scenarios)
-      .Value("--out-dir", o.out_dir)
-      .Value("--json", o.json)
-      .Value("--trains-dir", o.trains_dir)
-      .Value("--lines-dir", o.lines_dir)
-      .Value("--cycles-dir", o.cycles_dir)
-      .List("--only", o.only)
-      .Integer("--threads", o.threads, {.lo = 1, .hi = 64, .message = "{opt}: expected 1..64, got '{value}'"})
-      .Flag("--quiet", o.quiet)
-      .Require("--scenarios")
-      .Require("--out-dir");
+  char description[2048];
+  std::snprintf(description, sizeof description,
+                "Offline odometry study (REQ-RA-003..010, REQ-RA-014; D1 §3 items 6-9, D1 §5.2).\n"
+                "Every scenario (schema railproof/wheelrail-scenario/1) is simulated and replayed with the\n"
+                "IMU method (configured start points), with one start point and with the former\n"
+                "max/min-acceleration method. Checks: the true distance error at re-adhesion of every\n"
+                "compensation of the configured method within the error bound (ratio <= 1); the true\n"
+                "front inside the reported envelope in every cycle with a valid position (both IMU\n"
+                "runs); scenarios with expect_safe_reaction end in a maximum-time stop; sensor faults\n"
+                "give the typed rejection and stop reason; every train type's readhesion_margin_mm\n"
+                "covers the error model at %lld ms, %.4f deg/s and the steepest gradient of its line.",
+                static_cast<long long>(rp::max_compensation_ms), static_cast<double>(rp::imu_rate_error_udeg_s) / 1e6);
+  off::Cli cli("odometry_study", description, "Exit status: 0 pass, 1 a check failed (named on stderr), 2 bad input or error.");
+  cli.Add("--scenarios", o.scenarios, "scenario JSON files (a FILE, or every *.json of a DIR, sorted)")->required();
+  cli.Add("--out-dir", o.out_dir,
+          "per scenario <name>.svg (panels) and <name>.events.json; the summary plots\n"
+          "margin_vs_compensation_time.svg and clearing_time_cost.svg")
+      ->required();
+  cli.Add("--json", o.json,
+          "result JSON (requirements, verdict, worst_bound_ratio, scenarios, slip/slide phases,\n"
+          "episodes, start-point and baseline comparison, checks, margin and clearing-time\n"
+          "tables, train margins)");
+  cli.Add("--trains-dir", o.trains_dir, "generated train JSON");
+  cli.Add("--lines-dir", o.lines_dir, "generated line JSON");
+  cli.Add("--only", o.only, "only this scenario (file stem); repeatable");
+  cli.Add("--cycles-dir", o.cycles_dir,
+          "also write every cycle of the three runs as <name>.<run>.csv (truth, output,\n"
+          "machine state; for diagnosis)");
+  cli.Add("--threads", o.threads, "scenarios simulated in parallel")->check(off::InRange(1, 64));
+  cli.Add("--quiet", o.quiet, "no progress on stderr");
   cli.ParseOrExit(argc, argv);
   return o;
 }
@@ -778,13 +763,5 @@ int Main(int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  try {
-    return Main(argc, argv);
-  } catch (const InputError& e) {
-    std::fprintf(stderr, "odometry_study: %s\n", e.what());
-    return 2;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "odometry_study: error: %s\n", e.what());
-    return 2;
-  }
+  return railproof::offline::RunTool("odometry_study", [&] { return Main(argc, argv); });
 }

@@ -6,7 +6,6 @@
 // Exit status: 0 done; 2 bad input or error.
 #include <chrono>
 #include <cstdio>
-#include <exception>
 #include <string>
 
 #include "railproof/offline/cli.hpp"
@@ -14,26 +13,6 @@
 #include "railproof/ra/analysis/wheel_rail.hpp"
 
 namespace {
-
-using railproof::offline::InputError;
-
-void PrintHelp() {
-  std::printf(
-      "usage: wheelrail_sim --scenario FILE [--csv FILE] [--json FILE] [--quiet] [--help]\n"
-      "\n"
-      "Simulates a car (body, two bogies, four wheelsets; Box2D, vertical plane) on the\n"
-      "scenario's vertical alignment with a slip-dependent adhesion law, traction and brake\n"
-      "from the driver schedule, and writes the on-board odometry's sensor streams (TG and\n"
-      "IMU per 100 ms cycle, balise fixes, injected faults) with the truth.\n"
-      "\n"
-      "  --scenario FILE   scenario (format: spec/wheelrail/README.md)\n"
-      "  --csv FILE        one row per cycle: truth, TG, cycle-mean IMU\n"
-      "  --json FILE       every cycle's TG and IMU samples, balise, truth; the slip/slide events\n"
-      "  --quiet           no progress lines on stderr\n"
-      "\n"
-      "Prints a summary (distance, speeds, slip/slide events). Exit status: 0 done, 2 bad\n"
-      "input or error.\n");
-}
 
 struct Options {
   std::string scenario;
@@ -44,13 +23,18 @@ struct Options {
 
 Options ParseArgs(int argc, char** argv) {
   Options o;
-  railproof::offline::CliParser cli({.tool = "wheelrail_sim", .unknown = railproof::offline::CliStyle::Unknown::kQuoted},
-                                PrintHelp);
-  cli.Value("--scenario", o.scenario)
-      .Value("--csv", o.csv)
-      .Value("--json", o.json)
-      .Flag("--quiet", o.quiet)
-      .Require("--scenario");
+  railproof::offline::Cli cli(
+      "wheelrail_sim",
+      "Simulates a car (body, two bogies, four wheelsets; Box2D, vertical plane) on the\n"
+      "scenario's vertical alignment with a slip-dependent adhesion law, traction and brake\n"
+      "from the driver schedule, and writes the on-board odometry's sensor streams (TG and\n"
+      "IMU per 100 ms cycle, balise fixes, injected faults) with the truth.",
+      "Prints a summary (distance, speeds, slip/slide events). Exit status: 0 done, 2 bad\n"
+      "input or error.");
+  cli.Add("--scenario", o.scenario, "scenario (format: spec/wheelrail/README.md)")->required();
+  cli.Add("--csv", o.csv, "one row per cycle: truth, TG, cycle-mean IMU");
+  cli.Add("--json", o.json, "every cycle's TG and IMU samples, balise, truth; the slip/slide events");
+  cli.Add("--quiet", o.quiet, "no progress lines on stderr");
   cli.ParseOrExit(argc, argv);
   return o;
 }
@@ -95,13 +79,5 @@ int Main(int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  try {
-    return Main(argc, argv);
-  } catch (const InputError& e) {
-    std::fprintf(stderr, "wheelrail_sim: %s\n", e.what());
-    return 2;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "wheelrail_sim: error: %s\n", e.what());
-    return 2;
-  }
+  return railproof::offline::RunTool("wheelrail_sim", [&] { return Main(argc, argv); });
 }

@@ -66,6 +66,21 @@ class Reader {
   std::size_t pos_ = 0;
 };
 
+// What a payload holds: its first byte is 1 before a message; the single byte 0 is the
+// empty payload (no position, keep-alive); anything else is malformed.
+enum class Content : std::uint8_t { kMessage, kEmpty, kMalformed };
+
+Content Open(Reader& r) {
+  std::uint8_t kind = 0;
+  if (!r.U8(kind)) {
+    return Content::kMalformed;
+  }
+  if (kind == 0 && r.AtEnd()) {
+    return Content::kEmpty;
+  }
+  return kind == 1 ? Content::kMessage : Content::kMalformed;
+}
+
 }  // namespace
 
 std::vector<std::uint8_t> EncodePosition(const messages::PositionReport& r) {
@@ -85,19 +100,15 @@ std::vector<std::uint8_t> EncodePosition(const messages::PositionReport& r) {
 std::vector<std::uint8_t> EncodeNoPosition() { return {0}; }
 
 std::optional<messages::PositionReport> DecodePosition(std::span<const std::uint8_t> payload, bool& malformed) {
-  malformed = false;
   Reader r(payload);
-  std::uint8_t kind = 0;
-  if (!r.U8(kind)) {
-    malformed = true;
-    return std::nullopt;
-  }
-  if (kind == 0 && r.AtEnd()) {
+  const Content c = Open(r);
+  malformed = c == Content::kMalformed;
+  if (c != Content::kMessage) {
     return std::nullopt;
   }
   messages::PositionReport rep{};
   std::uint8_t dir = 0;
-  if (kind != 1 || !r.U32(rep.train_id) || !r.U32(rep.front_block) || !r.I64(rep.offset_mm) ||
+  if (!r.U32(rep.train_id) || !r.U32(rep.front_block) || !r.I64(rep.offset_mm) ||
       !r.I64(rep.length_mm) || !r.I64(rep.correction_mm) || !r.I64(rep.last_balise_mm) || !r.I64(rep.speed_mm_s) ||
       !r.U8(dir) || !r.AtEnd() || dir > 1) {
     malformed = true;
@@ -132,21 +143,17 @@ std::vector<std::uint8_t> EncodeStopLimit(const messages::StopLimitTelegram& t) 
 std::vector<std::uint8_t> EncodeKeepAlive() { return {0}; }
 
 std::optional<messages::StopLimitTelegram> DecodeStopLimit(std::span<const std::uint8_t> payload, bool& malformed) {
-  malformed = false;
   Reader r(payload);
-  std::uint8_t kind = 0;
-  if (!r.U8(kind)) {
-    malformed = true;
-    return std::nullopt;
-  }
-  if (kind == 0 && r.AtEnd()) {
+  const Content c = Open(r);
+  malformed = c == Content::kMalformed;
+  if (c != Content::kMessage) {
     return std::nullopt;
   }
   messages::StopLimitTelegram t{};
   std::uint8_t obstruction = 0;
   std::uint8_t n = 0;
   std::uint8_t truncated = 0;
-  if (kind != 1 || !r.U32(t.train_id) || !r.I64(t.limit_mm) || !r.U8(obstruction) || !r.I64(t.issue_time_ms) ||
+  if (!r.U32(t.train_id) || !r.I64(t.limit_mm) || !r.U8(obstruction) || !r.I64(t.issue_time_ms) ||
       !r.U8(n) || !r.U8(truncated) || n > kControlRestrictionsMax || obstruction > 8 || truncated > 1) {
     malformed = true;
     return std::nullopt;

@@ -14,6 +14,7 @@
 #include "railproof/sim/ground_line.hpp"
 #include "railproof/offline/line.hpp"
 #include "railproof/sim/scenario.hpp"
+#include "railproof/testing/input_error.hpp"
 
 namespace railproof::sim {
 namespace {
@@ -30,17 +31,7 @@ nlohmann::json TestLineJson() {
 void ExpectLineError(const std::function<void(nlohmann::json&)>& mutate, const std::vector<std::string>& fragments) {
   nlohmann::json j = TestLineJson();
   mutate(j);
-  try {
-    (void)ParseLine(j.dump(), "bad_line.json");
-    ADD_FAILURE() << "no error for " << fragments.front();
-  } catch (const InputError& e) {
-    const std::string msg = e.what();
-    EXPECT_EQ(msg.rfind("bad_line.json: ", 0), 0U) << msg;
-    EXPECT_EQ(msg.find('\n'), std::string::npos) << "one line: " << msg;
-    for (const auto& f : fragments) {
-      EXPECT_NE(msg.find(f), std::string::npos) << "'" << f << "' not in: " << msg;
-    }
-  }
+  testing::ExpectInputError([&] { (void)ParseLine(j.dump(), "bad_line.json"); }, "bad_line.json", fragments);
 }
 
 nlohmann::json& Up(nlohmann::json& j) { return j["running_lines"][0]; }
@@ -66,18 +57,9 @@ TEST(SimLineLoader, LoadsTheTestLine) {
 
 // @verifies REQ-MB-020
 TEST(SimLineLoader, RejectsUnreadableAndMalformedFiles) {
-  try {
-    (void)LoadLine(DataDir() / "no_such_line.json");
-    ADD_FAILURE();
-  } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("no_such_line.json: cannot read"), std::string::npos) << e.what();
-  }
-  try {
-    (void)ParseLine("{\"schema\": ", "trunc.json");
-    ADD_FAILURE();
-  } catch (const InputError& e) {
-    EXPECT_EQ(std::string(e.what()).rfind("trunc.json: invalid JSON", 0), 0U) << e.what();
-  }
+  const auto missing = DataDir() / "no_such_line.json";
+  testing::ExpectInputError([&] { (void)LoadLine(missing); }, missing.string(), {"cannot read"});
+  testing::ExpectInputError([] { (void)ParseLine("{\"schema\": ", "trunc.json"); }, "trunc.json", {"invalid JSON"});
   ExpectLineError([](auto& j) { j["schema"] = "railproof/line-json/0"; }, {"schema", "unsupported schema"});
 }
 
@@ -122,14 +104,8 @@ TEST(SimLineLoader, RejectsBadGeometry) {
 // @verifies REQ-MB-020
 TEST(SimLineLoader, RejectsAnUnknownRunningLine) {
   const Line line = LoadLine(DataDir() / "sim_test_line.json");
-  try {
-    (void)line.Running("sideways");
-    ADD_FAILURE();
-  } catch (const InputError& e) {
-    const std::string msg = e.what();
-    EXPECT_NE(msg.find("sim_test_line.json: unknown running line 'sideways' (the line has: up, down)"), std::string::npos)
-        << msg;
-  }
+  testing::ExpectInputError([&] { (void)line.Running("sideways"); }, line.file,
+                            {"unknown running line 'sideways' (the line has: up, down)"});
 }
 
 // @verifies REQ-MB-020
@@ -160,15 +136,8 @@ TEST(SimGroundLine, ALineTheGroundRefusesNamesTheEntry) {
   const Line line = ParseLine(j.dump(), "overlap.json");
   const RunningLine& up = line.Running("up");
   const GroundLine gl = BuildGroundLine(line, up, mb::wayside::MarginPolicy::kReportedCorrection, 500);
-  try {
-    (void)CreateGround(line, up, gl, 2);
-    ADD_FAILURE();
-  } catch (const InputError& e) {
-    const std::string msg = e.what();
-    EXPECT_NE(msg.find("overlap.json: running line 'up': the ground refuses the line: FixedBlockInvalid"), std::string::npos)
-        << msg;
-    EXPECT_NE(msg.find("fixed-block platforms[1]"), std::string::npos) << msg;
-  }
+  testing::ExpectInputError([&] { (void)CreateGround(line, up, gl, 2); }, "overlap.json",
+                            {"running line 'up': the ground refuses the line: FixedBlockInvalid", "fixed-block platforms[1]"});
 }
 
 // ---- scenario files --------------------------------------------------------------------
@@ -187,21 +156,15 @@ void ExpectScenarioError(const std::function<void(nlohmann::json&)>& mutate, con
                          bool against_line = false) {
   nlohmann::json j = MinimalScenario();
   mutate(j);
-  try {
-    const Scenario sc = ParseScenario(j.dump(), "bad_scenario.json");
-    if (against_line) {
-      const Line line = LoadLine(DataDir() / "sim_test_line.json");
-      CheckScenarioAgainstLine(sc, SelectRunningLine(sc, line));
-    }
-    ADD_FAILURE() << "no error for " << fragments.front();
-  } catch (const InputError& e) {
-    const std::string msg = e.what();
-    EXPECT_EQ(msg.rfind("bad_scenario.json: ", 0), 0U) << msg;
-    EXPECT_EQ(msg.find('\n'), std::string::npos) << msg;
-    for (const auto& f : fragments) {
-      EXPECT_NE(msg.find(f), std::string::npos) << "'" << f << "' not in: " << msg;
-    }
-  }
+  testing::ExpectInputError(
+      [&] {
+        const Scenario sc = ParseScenario(j.dump(), "bad_scenario.json");
+        if (against_line) {
+          const Line line = LoadLine(DataDir() / "sim_test_line.json");
+          CheckScenarioAgainstLine(sc, SelectRunningLine(sc, line));
+        }
+      },
+      "bad_scenario.json", fragments);
 }
 
 TEST(SimScenarioFile, ParsesAndFillsDefaultsFromTheParameters) {

@@ -1,5 +1,5 @@
-// Unit tests of the simulation's models: longitudinal dynamics (hand-checked cases),
-// supervision curves, the seeded channel, the SVG writer.
+// Unit tests of the simulation's models: the seeded channel (the train-motion model is tested
+// in offline/common).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -11,85 +11,9 @@
 #include "railproof/tg/frame.hpp"
 #include "railproof/tg/telegram.hpp"
 #include "railproof/sim/channel.hpp"
-#include "railproof/offline/dynamics.hpp"
-#include "railproof/offline/svg.hpp"
 
 namespace railproof::sim {
-using namespace ::railproof::offline;  // NOLINT(google-build-using-namespace)
 namespace {
-
-TrainPerformance NoResistance() {
-  TrainPerformance p;
-  p.length_m = 100.0;
-  p.max_speed_mps = 100.0 / 3.6;
-  p.accel_mps2 = 1.0;
-  p.service_decel_mps2 = 1.0;
-  p.emergency_decel_mps2 = 1.5;
-  p.resistance = Resistance{0.0, 0.0, 0.0};
-  return p;
-}
-
-TEST(SimDynamics, AccelerationFromStandstillMatchesHandCalculation) {
-  // a = 1 m/s^2 for 10 s: v = 10 m/s, s = a t^2 / 2 = 50 m (exact integration per step)
-  const TrainPerformance p = NoResistance();
-  Motion m{0.0, 0.0};
-  for (int k = 0; k < 100; ++k) {
-    const double a = NetAcceleration(p, Control{1.0, 0.0, false}, m.speed_mps, 0.0);
-    m = Advance(m, a, 0.1);
-  }
-  EXPECT_NEAR(m.speed_mps, 10.0, 1e-9);
-  EXPECT_NEAR(m.position_m, 50.0, 1e-9);
-}
-
-TEST(SimDynamics, ServiceAndEmergencyBrakingDistancesMatchHandCalculation) {
-  // from 20 m/s: service 1 m/s^2 stops in v^2 / 2b = 200 m after 20 s; emergency 1.5 m/s^2
-  // in 133.33 m; the train stops and does not roll back
-  const TrainPerformance p = NoResistance();
-  for (const bool emergency : {false, true}) {
-    Motion m{1000.0, 20.0};
-    int steps = 0;
-    while (m.speed_mps > 0.0 && steps < 1000) {
-      const double a = NetAcceleration(p, Control{0.0, 1.0, emergency}, m.speed_mps, 0.0);
-      m = Advance(m, a, 0.1);
-      ++steps;
-    }
-    const double b = emergency ? 1.5 : 1.0;
-    EXPECT_NEAR(m.position_m - 1000.0, 400.0 / (2.0 * b), 1e-9);
-    EXPECT_NEAR(steps * 0.1, 20.0 / b, 0.1 + 1e-9);
-    EXPECT_NEAR(StoppingDistance(20.0, b, 0.0), 400.0 / (2.0 * b), 1e-12);
-    const Motion still = Advance(m, NetAcceleration(p, Control{0.0, 1.0, emergency}, 0.0, 0.0), 0.1);
-    EXPECT_EQ(still.position_m, m.position_m);
-    EXPECT_EQ(still.speed_mps, 0.0);
-  }
-}
-
-TEST(SimDynamics, ResistanceGradientAndLimits) {
-  TrainPerformance p = NoResistance();
-  p.resistance = Resistance{1.5, 0.02, 0.0003};
-  // r(100 km/h) = 1.5 + 2 + 3 = 6.5 N/kN -> 9.81 * 6.5 / 1000 m/s^2
-  EXPECT_NEAR(ResistanceDecel(p.resistance, 100.0 / 3.6), 9.81 * 6.5 / 1000.0, 1e-12);
-  // a 10 per mille rise costs g * 0.01; coasting at standstill does not roll back
-  EXPECT_NEAR(NetAcceleration(NoResistance(), Control{}, 5.0, 10.0), -0.0981, 1e-12);
-  EXPECT_EQ(Advance(Motion{10.0, 0.0}, NetAcceleration(NoResistance(), Control{}, 0.0, 10.0), 0.1).position_m, 10.0);
-  // no traction at or above the maximum speed; traction and brake commands are clamped
-  EXPECT_NEAR(NetAcceleration(NoResistance(), Control{5.0, 0.0, false}, p.max_speed_mps, 0.0), 0.0, 1e-12);
-  EXPECT_NEAR(NetAcceleration(NoResistance(), Control{5.0, 0.0, false}, 1.0, 0.0), 1.0, 1e-12);
-  EXPECT_NEAR(NetAcceleration(NoResistance(), Control{0.0, 9.0, false}, 1.0, 0.0), -1.0, 1e-12);
-  EXPECT_NEAR(NetAcceleration(NoResistance(), Control{1.0, 0.0, true}, 1.0, 0.0), -1.5, 1e-12);
-}
-
-TEST(SimDynamics, CurveSpeedInvertsTheStoppingDistance) {
-  for (const double t : {0.0, 0.5, 2.0}) {
-    for (const double v : {1.0, 5.56, 16.7, 27.8}) {
-      const double d = StoppingDistance(v, 0.8, t);
-      EXPECT_NEAR(CurveSpeed(d, 0.8, t), v, 1e-9);
-    }
-  }
-  EXPECT_EQ(CurveSpeed(-1.0, 0.8, 1.0), 0.0);
-  EXPECT_EQ(CurveSpeed(10.0, 0.0, 1.0), 0.0);
-  // 20 km/h, 0.8 m/s^2, 1 s: 5.556 + 19.29 = 24.85 m
-  EXPECT_NEAR(StoppingDistance(20.0 / 3.6, 0.8, 1.0), 20.0 / 3.6 + (20.0 / 3.6) * (20.0 / 3.6) / 1.6, 1e-12);
-}
 
 // ---- channel ---------------------------------------------------------------------------
 
@@ -207,35 +131,6 @@ TEST(SimChannel, CorruptedFramesAreCorrectedOrRejectedByTheFrameDecoder) {
   EXPECT_GT(corrected, 0);
   EXPECT_GT(rejected, 0);
   EXPECT_EQ(ch.Stats(Direction::kUplink).corrupted, 400U);
-}
-
-// ---- SVG writer --------------------------------------------------------------------------
-
-TEST(SimSvg, WritesAxesLinesShadesAndLegend) {
-  SvgPlot plot(0.0, 600.0, 0.0, 14.5);
-  plot.SetTitle("a <title> & more");
-  plot.SetXLabel("time [s]");
-  plot.SetYLabel("distance [km]");
-  plot.AddPolyline({{0.0, 1.0}, {100.0, 2.0}, {200.0, std::nan("")}, {300.0, 3.0}}, SvgStyle{"#ff0000", 1.5, "", 1.0});
-  plot.AddRect(100.0, 200.0, 5.0, 6.0, "#ff9900", 0.3, "possession 1");
-  plot.AddHLine(2.0, "A", SvgStyle{"#999999", 0.5, "2 3", 1.0});
-  plot.AddLegend("train 2", SvgStyle{"#ff0000", 1.5, "", 1.0});
-  const std::string svg = plot.Render();
-  EXPECT_EQ(svg.rfind("<?xml", 0), 0U);
-  EXPECT_NE(svg.find("<svg xmlns=\"http://www.w3.org/2000/svg\""), std::string::npos);
-  EXPECT_NE(svg.find("a &lt;title&gt; &amp; more"), std::string::npos);
-  EXPECT_NE(svg.find("time [s]"), std::string::npos);
-  EXPECT_NE(svg.find("distance [km]"), std::string::npos);
-  EXPECT_NE(svg.find("possession 1"), std::string::npos);
-  EXPECT_NE(svg.find("train 2"), std::string::npos);
-  EXPECT_NE(svg.find("stroke-dasharray=\"2 3\""), std::string::npos);
-  // the NaN breaks the polyline into two pieces
-  const auto path = svg.find("<path d=\"M");
-  ASSERT_NE(path, std::string::npos);
-  EXPECT_NE(svg.find(" M", path + 10), std::string::npos);
-  EXPECT_NE(svg.find("</svg>"), std::string::npos);
-  EXPECT_DOUBLE_EQ(SvgPlot::TickStep(0.0, 600.0, 12), 50.0);
-  EXPECT_DOUBLE_EQ(SvgPlot::TickStep(0.0, 14.5, 10), 2.0);
 }
 
 }  // namespace

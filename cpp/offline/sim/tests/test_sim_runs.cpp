@@ -57,6 +57,24 @@ std::string Describe(const Simulation& sim) {
   return s;
 }
 
+// Runs the scenario to its end; no invariant may be violated. Returns the summary.
+nlohmann::ordered_json RunWithoutViolations(Simulation& sim) {
+  sim.Run();
+  EXPECT_TRUE(sim.Violations().empty()) << Describe(sim);
+  return sim.Summary();
+}
+
+// Steps to t_ms; train `id` must stand there. Returns its state.
+TrainView StandingAt(Simulation& sim, std::int64_t t_ms, std::uint16_t id) {
+  while (sim.NowMs() < t_ms) {
+    sim.Step();
+  }
+  const auto t = sim.Train(id);
+  EXPECT_TRUE(t.has_value()) << "train " << id;
+  EXPECT_EQ(t.value_or(TrainView{}).speed_mps, 0.0) << "train " << id;
+  return t.value_or(TrainView{});
+}
+
 // @verifies REQ-MB-008
 // @verifies REQ-MB-009
 // @verifies REQ-MB-024
@@ -66,9 +84,7 @@ TEST(SimRun, ShortScenarioWithLossyRadioHasNoViolations) {
   j["trains"].push_back(TrainJson(3, 600, 5));
   j["trains"].push_back(TrainJson(4, 300, 10));
   Simulation sim = Make(j);
-  sim.Run();
-  EXPECT_TRUE(sim.Violations().empty()) << Describe(sim);
-  const auto s = sim.Summary();
+  const auto s = RunWithoutViolations(sim);
   EXPECT_EQ(s["result"], "PASS");
   EXPECT_GT(s["radio"]["uplink"]["accepted"].get<int>(), 600);
   EXPECT_GT(s["radio"]["downlink"]["accepted"].get<int>(), 1200);
@@ -103,8 +119,7 @@ GapResult FollowGap(double leader_kmh) {
   j["trains"].push_back(TrainJson(3, 3650, 0));
   j["gap"] = {{"leader", 2}, {"follower", 3}, {"from_s", 240}, {"to_s", 420}};
   Simulation sim = Make(j);
-  sim.Run();
-  EXPECT_TRUE(sim.Violations().empty()) << Describe(sim);
+  RunWithoutViolations(sim);
   const auto g = sim.Gap();
   EXPECT_TRUE(g.has_value());
   return g.value_or(GapResult{});
@@ -140,18 +155,11 @@ TEST(SimRun, InjectedRadioLossStopsTheTrainWithoutViolations) {
   j["trains"].push_back(TrainJson(3, 400, 0));
   j["faults"] = {{{"type", "radio_loss"}, {"train", 2}, {"from_s", 100}, {"to_s", 160}}};
   Simulation sim = Make(j);
-  while (sim.NowMs() < 150'000) {
-    sim.Step();
-  }
-  const auto mid = sim.Train(2);
-  ASSERT_TRUE(mid.has_value());
-  EXPECT_EQ(mid->speed_mps, 0.0);
-  EXPECT_FALSE(mid->authority_usable);
-  EXPECT_TRUE(mid->abnormal);
-  EXPECT_GE(mid->emergency_brakes, 1U);
-  sim.Run();
-  EXPECT_TRUE(sim.Violations().empty()) << Describe(sim);
-  const auto f = sim.Summary()["faults"][0];
+  const TrainView mid = StandingAt(sim, 150'000, 2);
+  EXPECT_FALSE(mid.authority_usable);
+  EXPECT_TRUE(mid.abnormal);
+  EXPECT_GE(mid.emergency_brakes, 1U);
+  const auto f = RunWithoutViolations(sim)["faults"][0];
   ASSERT_FALSE(f["standstill_after_s"].is_null());
   ASSERT_FALSE(f["abnormal_after_s"].is_null());
   // authority validity 3 s + braking from 60 km/h at 1.2 m/s^2 (14 s)
@@ -159,7 +167,7 @@ TEST(SimRun, InjectedRadioLossStopsTheTrainWithoutViolations) {
   EXPECT_LE(f["abnormal_after_s"].get<double>(), 4.0);
   ASSERT_FALSE(f["moving_again_after_end_s"].is_null());
   EXPECT_LT(f["moving_again_after_end_s"].get<double>(), 10.0);
-  EXPECT_GT(sim.Train(2)->front_m, mid->front_m + 500.0);
+  EXPECT_GT(sim.Train(2)->front_m, mid.front_m + 500.0);
 }
 
 // @verifies REQ-MB-004
@@ -169,20 +177,12 @@ TEST(SimRun, TrackingLossMarksTheTrainAbnormalAndHoldsTheFollower) {
   j["trains"].push_back(TrainJson(3, 600, 0));
   j["faults"] = {{{"type", "tracking_loss"}, {"train", 2}, {"from_s", 90}, {"to_s", 150}}};
   Simulation sim = Make(j);
-  while (sim.NowMs() < 140'000) {
-    sim.Step();
-  }
-  const auto leader = sim.Train(2);
-  const auto follower = sim.Train(3);
-  ASSERT_TRUE(leader && follower);
-  EXPECT_TRUE(leader->abnormal);
-  EXPECT_EQ(leader->speed_mps, 0.0);
-  EXPECT_EQ(follower->speed_mps, 0.0);
+  const TrainView leader = StandingAt(sim, 140'000, 2);
+  const TrainView follower = StandingAt(sim, 140'000, 3);
+  EXPECT_TRUE(leader.abnormal);
   // the follower stands at least the abnormal-train margin behind the leader's rear
-  EXPECT_GT(leader->rear_m - follower->front_m, 50.0);
-  sim.Run();
-  EXPECT_TRUE(sim.Violations().empty()) << Describe(sim);
-  const auto f = sim.Summary()["faults"][0];
+  EXPECT_GT(leader.rear_m - follower.front_m, 50.0);
+  const auto f = RunWithoutViolations(sim)["faults"][0];
   ASSERT_FALSE(f["abnormal_after_s"].is_null());
   EXPECT_LE(f["abnormal_after_s"].get<double>(), 4.5);
   EXPECT_FALSE(f["tracked_again_after_end_s"].is_null());
@@ -195,16 +195,8 @@ TEST(SimRun, PossessionBecomesActiveAndNoTrainEntersIt) {
   j["trains"].push_back(TrainJson(2, 5500, 0));
   j["faults"] = {{{"type", "possession"}, {"begin_m", 7000}, {"end_m", 7400}, {"from_s", 10}, {"to_s", 150}}};
   Simulation sim = Make(j);
-  while (sim.NowMs() < 140'000) {
-    sim.Step();
-  }
-  const auto t = sim.Train(2);
-  ASSERT_TRUE(t.has_value());
-  EXPECT_EQ(t->speed_mps, 0.0);
-  EXPECT_LE(t->front_m, 7000.0 - 50.0);  // stopped before possession start minus margin
-  sim.Run();
-  EXPECT_TRUE(sim.Violations().empty()) << Describe(sim);
-  const auto s = sim.Summary();
+  EXPECT_LE(StandingAt(sim, 140'000, 2).front_m, 7000.0 - 50.0);  // before possession start minus margin
+  const auto s = RunWithoutViolations(sim);
   EXPECT_FALSE(s["faults"][0]["active_after_s"].is_null());
   EXPECT_GT(s["checks"]["REQ-MB-014"]["checks"].get<int>(), 0);
   EXPECT_GT(sim.Train(2)->front_m, 7400.0);  // continues after the cancellation
@@ -222,16 +214,8 @@ TEST(SimRun, SidingRouteRequestHoldsTrainsBeforeTheRouteEntrance) {
                  // locking keeps the main route until the train has passed
                  {{"type", "siding_request"}, {"from_s", 152}, {"to_s", 280}}};
   Simulation sim = Make(j);
-  while (sim.NowMs() < 140'000) {
-    sim.Step();
-  }
-  const auto t = sim.Train(2);
-  ASSERT_TRUE(t.has_value());
-  EXPECT_EQ(t->speed_mps, 0.0);
-  EXPECT_LE(t->front_m, 4950.0 - 30.0);  // route entrance minus the route margin
-  sim.Run();
-  EXPECT_TRUE(sim.Violations().empty()) << Describe(sim);
-  const auto s = sim.Summary();
+  EXPECT_LE(StandingAt(sim, 140'000, 2).front_m, 4950.0 - 30.0);  // route entrance minus the route margin
+  const auto s = RunWithoutViolations(sim);
   EXPECT_FALSE(s["faults"][0]["set_after_s"].is_null());
   EXPECT_FALSE(s["faults"][0]["freed_after_end_s"].is_null());
   ASSERT_FALSE(s["faults"][1]["set_after_s"].is_null());
@@ -268,13 +252,12 @@ TEST(SimRun, TrainsStopAtStationsAndLeaveAtTheTerminus) {
   t2["repeat"] = {{"count", 2}, {"interval_s", 60}};
   j["trains"].push_back(t2);
   Simulation sim = Make(j);
-  sim.Run();
-  EXPECT_TRUE(sim.Violations().empty()) << Describe(sim);
+  const auto s = RunWithoutViolations(sim);
   for (const auto& t : sim.Trains()) {
     EXPECT_EQ(t.stops_made, 2U) << "train " << t.id;
     EXPECT_EQ(t.phase, "exited") << "train " << t.id;
   }
-  EXPECT_EQ(sim.Summary()["progress"]["trains_left_line"], 2);
+  EXPECT_EQ(s["progress"]["trains_left_line"], 2);
 }
 
 TEST(SimRun, WritesAnEventLogAndADiagram) {

@@ -6,12 +6,9 @@
 // Exit status: 0 no invariant violated; 1 invariant violations; 2 bad input or error.
 #include <chrono>
 #include <cstdio>
-#include <exception>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
-#include <optional>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -27,41 +24,6 @@ namespace {
 
 using railproof::offline::InputError;
 using Json = nlohmann::ordered_json;
-
-void PrintHelp() {
-  std::printf(
-      "usage: line_sim --scenario FILE --lines-dir DIR [--log FILE] [--log-full] [--svg FILE]\n"
-      "                [--summary FILE] [--leader-cap-kmh V] [--sweep-leader-cap V1,V2,...]\n"
-      "                [--quiet] [--help]\n"
-      "\n"
-      "Simulates a moving-block line scenario: trains with simple longitudinal dynamics, the\n"
-      "ground (tracking, interlocking, stop limits) and on-board authority handling, position\n"
-      "reports and stop-limit telegrams through the radio telegram layer over a lossy, delaying\n"
-      "channel, and injected faults. Safety invariants are checked after every step.\n"
-      "\n"
-      "  --scenario FILE        scenario (format: spec/scenarios/README.md)\n"
-      "  --lines-dir DIR        directory of generated line JSON files (<line>.json)\n"
-      "  --log FILE             JSON event log (cycles, reports, telegrams, faults, limit\n"
-      "                         changes, violations) followed by the summary\n"
-      "  --log-full             also log every accepted report and stop-limit telegram\n"
-      "  --svg FILE             time-distance diagram (SVG)\n"
-      "  --summary FILE         machine-readable summary (JSON)\n"
-      "  --leader-cap-kmh V     override the speed cap of the scenario's gap leader\n"
-      "  --sweep-leader-cap L   run the scenario once per leader cap in the comma-separated\n"
-      "                         list L (km/h) and write one summary with the settled gaps\n"
-      "  --quiet                no progress lines on stderr\n"
-      "\n"
-      "Progress: one line per 10 %% of simulated time on stderr. Exit status: 0 no invariant\n"
-      "violated, 1 invariant violations, 2 bad input or error.\n");
-}
-
-// --leader-cap-kmh and every entry of --sweep-leader-cap.
-const railproof::offline::NumberRule kSpeedKmh{
-    .lo = 0.0, .hi = 400.0, .lo_open = true, .message = "{opt}: not a speed in (0, 400] km/h: '{value}'"};
-
-void WriteFile(const std::filesystem::path& path, const std::string& text) {
-  railproof::offline::WriteFileAtomic(path, text);
-}
 
 void SetLeaderCap(railproof::sim::Scenario& sc, double kmh) {
   if (!sc.gap) {
@@ -82,43 +44,40 @@ struct Options {
   std::string summary;
   bool log_full = false;
   bool quiet = false;
-  std::optional<double> leader_cap;
+  double leader_cap_kmh = 0.0;  // 0: the scenario's
   std::vector<double> sweep;
 };
 
 Options ParseArgs(int argc, char** argv) {
+  namespace off = railproof::offline;
   Options o;
-  railproof::offline::CliParser cli({.tool = "line_sim", .unknown = railproof::offline::CliStyle::Unknown::kQuoted}, PrintHelp);
-  cli.Value("--scenario", o.scenario)
-      .Value("--lines-dir", o.lines_dir)
-      .Value("--log", o.log)
-      .Flag("--log-full", o.log_full)
-      .Value("--svg", o.svg)
-      .Value("--summary", o.summary)
-      .Flag("--quiet", o.quiet)
-      .Number("--leader-cap-kmh", [&](double v) { o.leader_cap = v; }, kSpeedKmh)
-      .Custom("--sweep-leader-cap",
-              [&](const std::string& list) -> std::optional<std::string> {
-                std::stringstream ss(list);
-                std::string item;
-                while (std::getline(ss, item, ',')) {
-                  double v = 0.0;
-                  if (auto error = railproof::offline::ParseCliNumber("--sweep-leader-cap", item, kSpeedKmh, v)) {
-                    return error;
-                  }
-                  o.sweep.push_back(v);
-                }
-                if (o.sweep.empty()) {
-                  return "--sweep-leader-cap: empty list";
-                }
-                return std::nullopt;
-              })
-      .Require("--scenario")
-      .Require("--lines-dir");
+  off::Cli cli("line_sim",
+               "Simulates a moving-block line scenario: trains with simple longitudinal dynamics, the\n"
+               "ground (tracking, interlocking, stop limits) and on-board authority handling, position\n"
+               "reports and stop-limit telegrams through the radio telegram layer over a lossy, delaying\n"
+               "channel, and injected faults. Safety invariants are checked after every step.",
+               "Progress: one line per 10 % of simulated time on stderr. Exit status: 0 no invariant\n"
+               "violated, 1 invariant violations, 2 bad input or error.");
+  const CLI::Validator speed = off::InRange(0.0, 400.0, true);
+  cli.Add("--scenario", o.scenario, "scenario (format: spec/scenarios/README.md)")->required();
+  cli.Add("--lines-dir", o.lines_dir, "directory of generated line JSON files (<line>.json)")->required();
+  cli.Add("--log", o.log,
+          "JSON event log (cycles, reports, telegrams, faults, limit changes, violations)\n"
+          "followed by the summary");
+  cli.Add("--log-full", o.log_full, "also log every accepted report and stop-limit telegram");
+  cli.Add("--svg", o.svg, "time-distance diagram (SVG)");
+  cli.Add("--summary", o.summary, "machine-readable summary (JSON)");
+  cli.Add("--leader-cap-kmh", o.leader_cap_kmh, "override the speed cap of the scenario's gap leader (km/h)")
+      ->check(speed);
+  cli.Add("--sweep-leader-cap", o.sweep,
+          "run the scenario once per leader cap of the comma-separated list (km/h) and write one\n"
+          "summary with the settled gaps")
+      ->delimiter(',')
+      ->check(speed)
+      ->excludes("--log")
+      ->excludes("--svg");
+  cli.Add("--quiet", o.quiet, "no progress lines on stderr");
   cli.ParseOrExit(argc, argv);
-  if (!o.sweep.empty() && (!o.log.empty() || !o.svg.empty())) {
-    cli.Fail("--sweep-leader-cap writes only --summary (no --log / --svg)");
-  }
   return o;
 }
 
@@ -183,14 +142,14 @@ int Main(int argc, char** argv) {
              {"result", all_pass ? "PASS" : "FAIL"}};
     std::printf("gap grows with the leader's speed: %s\n", grows ? "yes" : "no");
     if (!o.summary.empty()) {
-      WriteFile(o.summary, out.dump(1) + "\n");
+      railproof::offline::WriteFileAtomic(o.summary, out.dump(1) + "\n");
     }
     return all_pass ? 0 : 1;
   }
 
   auto sc = base;
-  if (o.leader_cap) {
-    SetLeaderCap(sc, *o.leader_cap);
+  if (o.leader_cap_kmh > 0.0) {
+    SetLeaderCap(sc, o.leader_cap_kmh);
   }
   railproof::sim::Simulation sim(sc, line);
   std::ofstream log;
@@ -218,10 +177,10 @@ int Main(int argc, char** argv) {
   }
   const Json s = sim.Summary();
   if (!o.summary.empty()) {
-    WriteFile(o.summary, s.dump(1) + "\n");
+    railproof::offline::WriteFileAtomic(o.summary, s.dump(1) + "\n");
   }
   if (!o.svg.empty()) {
-    WriteFile(o.svg, sim.Svg());
+    railproof::offline::WriteFileAtomic(o.svg, sim.Svg());
   }
   PrintResult(s, wall);
   return s["result"] == "PASS" ? 0 : 1;
@@ -230,13 +189,5 @@ int Main(int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  try {
-    return Main(argc, argv);
-  } catch (const InputError& e) {
-    std::fprintf(stderr, "line_sim: %s\n", e.what());
-    return 2;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "line_sim: error: %s\n", e.what());
-    return 2;
-  }
+  return railproof::offline::RunTool("line_sim", [&] { return Main(argc, argv); });
 }

@@ -33,6 +33,19 @@ using railproof::tg::RsParams;
 using railproof::tg::RsStatus;
 using Bytes = std::vector<std::uint8_t>;
 
+// The design point: RS(66,50) over GF(2^8), 4 blocks, 9600 bit/s, target 1e-9 per hour,
+// CRC-16 and a 128-bit tag.
+ResidualConfig DesignConfig() {
+  ResidualConfig cfg{};
+  cfg.code = {66, 50, 8};
+  cfg.blocks = 4;
+  cfg.bit_rate_bps = 9600.0;
+  cfg.target_per_hour = 1e-9;
+  cfg.crc_pass = std::ldexp(1.0L, -16);
+  cfg.tag_pass = std::ldexp(1.0L, -128);
+  return cfg;
+}
+
 // Primitive polynomials (ASM-008 for m = 8).
 unsigned PrimitivePoly(unsigned m) {
   switch (m) {
@@ -336,13 +349,7 @@ TEST(ResidualError, SymbolErrorProbabilityIsAccurateForTinyBer) {
 // meets the 1e-9 /h target even without the authentication tag.
 // @verifies REQ-TG-019
 TEST(ResidualError, FrameAndHourlyRates) {
-  ResidualConfig cfg{};
-  cfg.code = {66, 50, 8};
-  cfg.blocks = 4;
-  cfg.bit_rate_bps = 9600.0;
-  cfg.target_per_hour = 1e-9;
-  cfg.crc_pass = std::ldexp(1.0L, -16);
-  cfg.tag_pass = std::ldexp(1.0L, -128);
+  const ResidualConfig cfg = DesignConfig();
   const auto r = ComputeResidual(cfg, 1e-3);
   const long double pm = r.block.p_miscorrect;
   const long double pc = r.block.p_correct;
@@ -381,13 +388,7 @@ TEST(ResidualError, FrameAndHourlyRates) {
 
 // @verifies REQ-TG-019
 TEST(ResidualError, RejectsBadInput) {
-  ResidualConfig cfg{};
-  cfg.code = {66, 50, 8};
-  cfg.blocks = 4;
-  cfg.bit_rate_bps = 9600.0;
-  cfg.target_per_hour = 1e-9;
-  cfg.crc_pass = std::ldexp(1.0L, -16);
-  cfg.tag_pass = std::ldexp(1.0L, -128);
+  const ResidualConfig cfg = DesignConfig();
   EXPECT_THROW(ComputeResidual(cfg, -1e-3), std::invalid_argument);
   EXPECT_THROW(ComputeResidual(cfg, 1.5), std::invalid_argument);
   EXPECT_THROW(ComputeResidual(cfg, std::nan("")), std::invalid_argument);
@@ -419,13 +420,8 @@ TEST(ResidualError, RejectsBadInput) {
 // The readable table names the code, the per-hour definition inputs and a verdict per ber.
 // @verifies REQ-TG-019
 TEST(ResidualError, ReadableTable) {
-  ResidualConfig cfg{};
-  cfg.code = {66, 50, 8};
+  ResidualConfig cfg = DesignConfig();
   cfg.blocks = 3;
-  cfg.bit_rate_bps = 9600.0;
-  cfg.target_per_hour = 1e-9;
-  cfg.crc_pass = std::ldexp(1.0L, -16);
-  cfg.tag_pass = std::ldexp(1.0L, -128);
   const std::string table =
       ResidualReportTable(cfg, {ComputeResidual(cfg, 1e-3), ComputeResidual(cfg, 1e-4)});
   EXPECT_NE(table.find("RS(66,50) over GF(2^8) (d = 17, t = 8), 3 block(s) per frame = 1584 bits"),

@@ -682,28 +682,13 @@ class VectorTest : public testing::Test {
   std::size_t index_;
 };
 
-void Usage(std::FILE* f) {
-  std::fprintf(f,
-               "usage: railproof_conformance_lc --vectors DIR [--junit FILE] [gtest flags]\n"
-               "Replays every lc*.jsonl vector of DIR against the C++ level-crossing units\n"
-               "(lc::onboard::CrossingProtection, lc::wayside::CrossingController, lc::wayside::CentreScheduler),\n"
-               "configured by each file's header. Exit 0 only if every vector matches.\n");
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
-  const rcli::RunnerArgs args = rcli::ParseArgsAndInitGoogleTest("railproof-conformance-lc", argc, argv, Usage);
-  if (args.exit_code >= 0) {
-    return args.exit_code;
-  }
-  std::string error;
-  const bool ok = Load(args.vectors_dir, error);
-  return rcli::RunVectorTests(
-      "railproof-conformance-lc", "LevelCrossingConformance", args, ok, error, ok ? g_vectors.size() : 0, g_files.size(),
-      [](std::size_t i) {
-        const Vector& v = g_vectors[i];
-        return rcli::VectorSite{v.test_name, v.file, static_cast<int>(v.line)};
-      },
-      [](std::size_t i) -> testing::Test* { return new VectorTest(i); }, g_mismatched, g_replayed);
+  return rcli::RunnerMain<VectorTest>(
+      "railproof-conformance-lc", "LevelCrossingConformance",
+      "Replays every lc*.jsonl vector of DIR against the C++ level-crossing units\n"
+      "(lc::onboard::CrossingProtection, lc::wayside::CrossingController, lc::wayside::CentreScheduler),\n"
+      "configured by each file's header. Exit 0 only if every vector matches.",
+      argc, argv, Load, g_vectors, g_files, g_mismatched, g_replayed);
 }

@@ -334,38 +334,24 @@ class VectorTest : public testing::Test {
   std::size_t index_;
 };
 
-
-void Usage(std::FILE* f) {
-  std::fprintf(f,
-               "usage: railproof_conformance_mb --vectors DIR [--junit FILE] [gtest flags]\n"
-               "Replays every mb*.jsonl vector of DIR against the C++ ground and on-board units.\n");
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
-  const rcli::RunnerArgs args = rcli::ParseArgsAndInitGoogleTest("railproof-conformance-mb", argc, argv, Usage);
-  if (args.exit_code >= 0) {
-    return args.exit_code;
-  }
-  const std::string& vectors_dir = args.vectors_dir;
-
-  std::string error;
-  const bool ok = Load(vectors_dir, error);
-  std::set<std::string> files;
-  for (const Header& h : g_headers) {
-    files.insert(h.file);
-  }
-  const std::size_t n = ok ? g_vectors.size() : 0;
-  testing::RegisterTest("MovingBlockConformance", "VectorSet", nullptr, nullptr, __FILE__, __LINE__,
-                        [error, nfiles = files.size(), n]() -> testing::Test* { return new rcli::VectorSetTest(error, nfiles, n); });
-  for (std::size_t i = 0; i < n; ++i) {
-    const Vector& v = g_vectors[i];
-    testing::RegisterTest("MovingBlockConformance", v.test_name.c_str(), nullptr, nullptr,
-                          g_headers[v.header].file.c_str(), static_cast<int>(v.line),
-                          [i]() -> testing::Test* { return new VectorTest(i); });
-  }
-  rcli::ReportLoad("railproof-conformance-mb", ok, error, n, files.size(), vectors_dir);
-  const int rc_tests = RUN_ALL_TESTS();
-  return rcli::Finish("railproof-conformance-mb", ok, error, g_mismatched.load(), g_replayed.load(), n, rc_tests);
+  return rcli::RunnerMain(
+      "railproof-conformance-mb", "MovingBlockConformance",
+      "Replays every mb*.jsonl vector of DIR against the C++ ground and on-board units.", argc, argv,
+      [](const std::string& dir) {
+        std::string error;
+        const bool ok = Load(dir, error);
+        std::set<std::string> files;
+        for (const Header& h : g_headers) {
+          files.insert(h.file);
+        }
+        return rcli::LoadedSet{ok, error, g_vectors.size(), files.size()};
+      },
+      [](std::size_t i) {
+        const Vector& v = g_vectors[i];
+        return rcli::VectorSite{v.test_name, g_headers[v.header].file, static_cast<int>(v.line)};
+      },
+      [](std::size_t i) -> testing::Test* { return new VectorTest(i); }, g_mismatched, g_replayed);
 }

@@ -14,6 +14,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <set>
 #include <array>
 #include <atomic>
 #include <cstdint>
@@ -226,52 +227,26 @@ class VectorTest : public testing::Test {
   std::size_t index_;
 };
 
-
-void Usage(std::FILE* out) {
-  std::fprintf(out,
-               "usage: railproof_conformance --vectors DIR [--junit FILE] [gtest flags]\n"
-               "Replays every vector of DIR/*.jsonl (spec/design/tg.md §7) against the\n"
-               "radio endpoint; one test per vector. --junit FILE writes JUnit XML (same as\n"
-               "--gtest_output=xml:FILE); other --gtest_* flags are passed to GoogleTest.\n"
-               "Exit status 0 only if the set is non-empty, well formed and every vector passes;\n"
-               "1 if not; 2 on bad arguments.\n");
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
-  // Own flags first; everything else goes to GoogleTest (--junit becomes --gtest_output,
-  // which GoogleTest reads during InitGoogleTest).
-  const rcli::RunnerArgs args = rcli::ParseArgsAndInitGoogleTest("railproof-conformance-tg", argc, argv, Usage);
-  if (args.exit_code >= 0) {
-    return args.exit_code;
-  }
-  const std::string& vectors_dir = args.vectors_dir;
-
-  rc::LoadResult loaded = rc::LoadVectorDirectory(vectors_dir);
-  std::size_t files = 0;
-  {
-    std::vector<std::string> names;
-    for (const auto& h : loaded.set.headers) {
-      names.push_back(h.file);
-    }
-    std::sort(names.begin(), names.end());
-    files = static_cast<std::size_t>(std::unique(names.begin(), names.end()) - names.begin());
-  }
-  if (loaded.ok) {
-    g_set = std::move(loaded.set);
-  }
-  const std::size_t vector_count = g_set.vectors.size();
-  testing::RegisterTest("TelegramConformance", "VectorSet", nullptr, nullptr, __FILE__, __LINE__,
-                        [error = loaded.error, files, vector_count]() -> testing::Test* {
-                          return new rcli::VectorSetTest(error, files, vector_count);
-                        });
-  for (std::size_t i = 0; i < vector_count; ++i) {
-    const rc::Vector& v = g_set.vectors[i];
-    testing::RegisterTest("TelegramConformance", v.test_name.c_str(), nullptr, nullptr, v.file.c_str(),
-                          static_cast<int>(v.line), [i]() -> testing::Test* { return new VectorTest(i); });
-  }
-  rcli::ReportLoad("railproof-conformance-tg", loaded.ok, loaded.error, vector_count, files, vectors_dir);
-  const int rc_tests = RUN_ALL_TESTS();
-  return rcli::Finish("railproof-conformance-tg", loaded.ok, loaded.error, g_mismatched.load(), g_replayed.load(), vector_count, rc_tests);
+  return rcli::RunnerMain(
+      "railproof-conformance-tg", "TelegramConformance",
+      "Replays every vector of DIR/*.jsonl (spec/design/tg.md §7) against the radio endpoint;\n"
+      "one test per vector. Exit 0 only if the set is non-empty, well formed and every vector\n"
+      "passes.",
+      argc, argv,
+      [](const std::string& dir) {
+        rc::LoadResult loaded = rc::LoadVectorDirectory(dir);
+        std::set<std::string> files;
+        for (const auto& h : loaded.set.headers) {
+          files.insert(h.file);
+        }
+        if (loaded.ok) {
+          g_set = std::move(loaded.set);
+        }
+        return rcli::LoadedSet{loaded.ok, loaded.error, g_set.vectors.size(), files.size()};
+      },
+      [](std::size_t i) { return rcli::SiteOf(g_set.vectors, i); },
+      [](std::size_t i) -> testing::Test* { return new VectorTest(i); }, g_mismatched, g_replayed);
 }

@@ -1,20 +1,24 @@
 // Command line, test registration and exit protocol shared by the conformance runners
-// (railproof_conformance, _mb, _br, _ra, _lc):
+// (railproof_conformance_<cap>): RunnerMain is their main().
 //   <runner> --vectors DIR [--junit FILE] [--gtest_* flags]
-// Exit status 0 if every vector passed, 1 if not (or no usable vector set), 2 on bad
-// arguments. The last line printed is one of
+// The command line is parsed by CLI11, as every tool's (railproof/offline/cli.hpp): --help
+// prints the generated help and exits 0; bad usage prints "<prog>: error: <reason> (see
+// --help)" and exits 2. Exit status 0 if every vector passed, 1 if not (or no usable vector
+// set). The last line printed is one of
 //   "<prog>: all N vectors passed (M in the set)"
 //   "<prog>: vectors mismatched: K of N"      (the seeded-fault tests look for K > 0)
 //   "<prog>: error: <reason>"
 #pragma once
 
+#include <CLI/CLI.hpp>
 #include <gtest/gtest.h>
 
 #include <atomic>
 #include <cstddef>
 #include <cstdio>
-#include <cstring>
+#include <filesystem>
 #include <functional>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -46,39 +50,47 @@ class VectorSetTest : public testing::Test {
   std::size_t vectors_;
 };
 
-// Reads the runner's own flags, passes --gtest_* flags (and --junit as --gtest_output) to
-// GoogleTest and initialises it.
-inline RunnerArgs ParseArgsAndInitGoogleTest(const char* prog, int argc, char** argv,
-                                             void (*usage)(std::FILE*)) {
+// Reads the runner's own flags (CLI11), passes --gtest_* flags (and --junit as --gtest_output)
+// to GoogleTest and initialises it. `description` opens the help.
+inline RunnerArgs ParseArgsAndInitGoogleTest(const char* prog, const std::string& description, int argc, char** argv) {
   RunnerArgs out;
   std::string junit;
-  std::vector<std::string> gtest_args = {argc > 0 ? argv[0] : prog};
-  for (int i = 1; i < argc; ++i) {
-    const std::string arg = argv[i];
-    if (arg == "--help" || arg == "-h") {
-      usage(stdout);
-      out.exit_code = 0;
-      return out;
-    }
-    if ((arg == "--vectors" || arg == "--junit") && i + 1 < argc) {
-      (arg == "--vectors" ? out.vectors_dir : junit) = argv[++i];
-    } else if (arg.rfind("--vectors=", 0) == 0) {
-      out.vectors_dir = arg.substr(std::strlen("--vectors="));
-    } else if (arg.rfind("--junit=", 0) == 0) {
-      junit = arg.substr(std::strlen("--junit="));
-    } else if (arg.rfind("--gtest_", 0) == 0) {
-      gtest_args.push_back(arg);
-    } else {
-      std::fprintf(stderr, "%s: error: unknown or incomplete argument \"%s\" (see --help)\n", prog,
-                   arg.c_str());
-      out.exit_code = 2;
-      return out;
-    }
-  }
-  if (out.vectors_dir.empty()) {
-    std::fprintf(stderr, "%s: error: --vectors DIR is required (see --help)\n", prog);
+  CLI::App app(description, prog);
+  app.allow_extras();  // the --gtest_* flags, checked below
+  app.add_option("--vectors", out.vectors_dir, "directory of the conformance vectors (*.jsonl)")->required();
+  app.add_option("--junit", junit, "write JUnit XML (as --gtest_output=xml:FILE)");
+  app.footer("Other --gtest_* flags are passed to GoogleTest. Exit status: 0 every vector passed; 1 a\n"
+             "vector failed or the vector set is missing, empty or malformed; 2 bad usage.");
+  const auto usage_error = [&](const std::string& reason) {
+    std::fprintf(stderr, "%s: error: %s (see --help)\n", prog, reason.c_str());
     out.exit_code = 2;
     return out;
+  };
+  // the first argument left over that is not a GoogleTest flag
+  const auto stray = [&]() -> std::optional<std::string> {
+    for (const std::string& a : app.remaining()) {
+      if (a.rfind("--gtest_", 0) != 0) {
+        return a;
+      }
+    }
+    return std::nullopt;
+  };
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp&) {
+    std::fputs(app.help().c_str(), stdout);
+    out.exit_code = 0;
+    return out;
+  } catch (const CLI::ParseError& e) {
+    const std::optional<std::string> a = stray();
+    return usage_error(a ? "unknown argument \"" + *a + "\"" : std::string(e.what()));
+  }
+  if (const std::optional<std::string> a = stray()) {
+    return usage_error("unknown argument \"" + *a + "\"");
+  }
+  std::vector<std::string> gtest_args = {argc > 0 ? argv[0] : prog};
+  for (const std::string& a : app.remaining()) {
+    gtest_args.push_back(a);
   }
   if (!junit.empty()) {
     gtest_args.push_back("--gtest_output=xml:" + junit);
@@ -91,8 +103,7 @@ inline RunnerArgs ParseArgsAndInitGoogleTest(const char* prog, int argc, char** 
   int gtest_argc = static_cast<int>(gtest_args.size());
   testing::InitGoogleTest(&gtest_argc, gtest_argv.data());
   if (gtest_argc > 1) {
-    std::fprintf(stderr, "%s: error: unknown GoogleTest flag \"%s\"\n", prog, gtest_argv[1]);
-    out.exit_code = 2;
+    return usage_error("unknown GoogleTest flag \"" + std::string(gtest_argv[1]) + "\"");
   }
   return out;
 }
@@ -133,24 +144,64 @@ struct VectorSite {
   int line = 0;
 };
 
-// Registers the VectorSet test and one test per loaded vector (suite `suite`), prints the
-// load result, runs the tests and applies the exit protocol. site(i) names vector i's test,
-// make_test(i) creates it; n is the number of vectors loaded (0 if the load failed).
-inline int RunVectorTests(const char* prog, const char* suite, const RunnerArgs& args, bool ok,
-                          const std::string& error, std::size_t n, std::size_t files,
-                          const std::function<VectorSite(std::size_t)>& site,
-                          const std::function<testing::Test*(std::size_t)>& make_test,
-                          const std::atomic<std::size_t>& mismatched, const std::atomic<std::size_t>& replayed) {
+// The site of vector i of a container whose vectors know their test name, file and line.
+template <typename Vectors>
+VectorSite SiteOf(const Vectors& vectors, std::size_t i) {
+  return {vectors[i].test_name, vectors[i].file, static_cast<int>(vectors[i].line)};
+}
+
+// What a runner's loader found in the vector directory.
+struct LoadedSet {
+  bool ok = false;
+  std::string error;        // why the set is not usable (ok false)
+  std::size_t vectors = 0;  // loaded (0 if not ok)
+  std::size_t files = 0;
+};
+
+// The main() of a runner: parses the arguments (prog names it in every line, suite is the
+// GoogleTest suite, description opens --help), loads the vector directory, registers the
+// VectorSet test and one test per vector (site(i) names vector i's test, make_test(i)
+// creates it), prints the load result, runs the tests and applies the exit protocol.
+inline int RunnerMain(const char* prog, const char* suite, const std::string& description, int argc, char** argv,
+                      const std::function<LoadedSet(const std::string& dir)>& load,
+                      const std::function<VectorSite(std::size_t)>& site,
+                      const std::function<testing::Test*(std::size_t)>& make_test,
+                      const std::atomic<std::size_t>& mismatched, const std::atomic<std::size_t>& replayed) {
+  const RunnerArgs args = ParseArgsAndInitGoogleTest(prog, description, argc, argv);
+  if (args.exit_code >= 0) {
+    return args.exit_code;
+  }
+  const LoadedSet set = load(args.vectors_dir);
+  const std::size_t n = set.ok ? set.vectors : 0;
   testing::RegisterTest(suite, "VectorSet", nullptr, nullptr, __FILE__, __LINE__,
-                        [error, files, n]() -> testing::Test* { return new VectorSetTest(error, files, n); });
+                        [error = set.error, files = set.files, n]() -> testing::Test* {
+                          return new VectorSetTest(error, files, n);
+                        });
   for (std::size_t i = 0; i < n; ++i) {
     const VectorSite at = site(i);
     testing::RegisterTest(suite, at.test_name.c_str(), nullptr, nullptr, at.file.c_str(), at.line,
                           [make_test, i]() -> testing::Test* { return make_test(i); });
   }
-  ReportLoad(prog, ok, error, n, files, args.vectors_dir);
+  ReportLoad(prog, set.ok, set.error, n, set.files, args.vectors_dir);
   const int rc_tests = RUN_ALL_TESTS();
-  return Finish(prog, ok, error, mismatched.load(), replayed.load(), n, rc_tests);
+  return Finish(prog, set.ok, set.error, mismatched.load(), replayed.load(), n, rc_tests);
+}
+
+// RunnerMain for a runner whose load(dir, error) fills `vectors` (each knowing its test name,
+// file and line) and the set of `files`, and whose Test is constructed from a vector's index.
+template <typename Test, typename Vectors, typename Files>
+int RunnerMain(const char* prog, const char* suite, const std::string& description, int argc, char** argv,
+               bool (*load)(const std::filesystem::path& dir, std::string& error), const Vectors& vectors,
+               const Files& files, const std::atomic<std::size_t>& mismatched, const std::atomic<std::size_t>& replayed) {
+  return RunnerMain(
+      prog, suite, description, argc, argv,
+      [&](const std::string& dir) {
+        std::string error;
+        const bool ok = load(dir, error);
+        return LoadedSet{ok, error, vectors.size(), files.size()};
+      },
+      [&](std::size_t i) { return SiteOf(vectors, i); }, [](std::size_t i) -> testing::Test* { return new Test(i); },
+      mismatched, replayed);
 }
 
 }  // namespace railproof::conformance

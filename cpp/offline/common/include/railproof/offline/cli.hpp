@@ -1,74 +1,30 @@
-// Command-line parsing of the offline tools: a table of options (string value, repeated
-// string, flag, bounded integer, bounded number, or a custom handler) bound to the tool's
-// variables, parsed in order; the first error ends the parse. Parse() only reports (for
-// tests); ParseOrExit() prints the tool's help on --help / -h and exits 0, or prints the
-// error as "<tool>: <reason>[ (see --help)]" on stderr and exits with the tool's error code.
-// Offline module. Registration mistakes (a name twice, --help / -h, a flag in a kPaired
-// tool, Require of an option without a string target) throw std::logic_error.
+// Command line of the offline tools: CLI11 (Debian libcli11-dev, header-only) with the
+// project's conventions, so that every tool behaves alike:
+//   - --help / -h prints the generated help (usage, the tool's description, every option
+//     with its text, the footer) on stdout and exits 0;
+//   - bad usage prints one line "<tool>: <reason> (see --help)" on stderr and exits 2; an
+//     unknown or unexpected argument is reported before a missing required option;
+//   - a repeatable option (std::vector target) takes one value per occurrence, kept in
+//     order; a number must be the whole text and, if floating-point, finite;
+//   - RunTool() is the tool's main(): bad input (InputError) prints "<tool>: <reason>", any
+//     other exception "<tool>: error: <reason>", both exit 2.
+// The conformance runners use CLI11 the same way (railproof/testing/runner_cli.hpp).
+// Why a library: one well-kept parser for every tool and runner instead of three hand-written
+// ones, and the help is generated from the same table that parses, so a usage text cannot
+// drift from the options; what is the project's own is only these conventions.
+// Offline module (may allocate and throw).
 #pragma once
 
-#include <cstddef>
+#include <CLI/CLI.hpp>
+
 #include <functional>
 #include <limits>
-#include <optional>
 #include <string>
-#include <string_view>
 #include <type_traits>
 #include <utility>
 #include <vector>
 
 namespace railproof::offline {
-
-// How a tool words and handles its command-line errors.
-struct CliStyle {
-  enum class Unknown {
-    kColon,   // "unknown option: X"
-    kQuoted,  // "unknown option 'X'"
-  };
-  enum class Values {
-    // The option's entry decides whether a value follows; a value option that is last:
-    // "X needs a value".
-    kNamed,
-    // Every argument but --help / -h is an option followed by its value, checked before the
-    // name is looked up: the last argument gives "unknown option or missing value: X".
-    // No flags in this style.
-    kPaired,
-  };
-  std::string tool{};              // prefix of every message: "<tool>: "
-  Unknown unknown = Unknown::kColon;
-  Values values = Values::kNamed;
-  bool see_help = true;            // " (see --help)" after every reason
-  int error_exit = 2;              // exit status of ParseOrExit / Fail
-};
-
-// A floating-point value (std::strtod: the whole text, finite). In `message` and
-// `range_message`, "{opt}" is replaced by the option and "{value}" by the text given; an
-// empty message means "{opt}: invalid value '{value}'".
-struct NumberRule {
-  double lo = -std::numeric_limits<double>::infinity();
-  double hi = std::numeric_limits<double>::infinity();
-  bool lo_open = false;             // lo < v instead of lo <= v
-  bool reject_range_error = false;  // strtod's ERANGE (overflow or underflow) is malformed
-  std::string message{};            // a malformed value, or out of [lo, hi] without range_message
-  std::string range_message{};      // a well-formed value out of [lo, hi] (optional)
-};
-
-// A whole number (std::strtoll, base 10, the whole text) that must fit the target type
-// (else `message`) and lie in [lo, hi] (else range_message, or message without one).
-struct IntegerRule {
-  long long lo = std::numeric_limits<long long>::min();
-  long long hi = std::numeric_limits<long long>::max();
-  bool digits_only = false;  // only 0-9 (no blanks, no sign), as std::from_chars of an unsigned
-  std::string message{};
-  std::string range_message{};
-};
-
-// The number of `text` as the value of `opt`, or the reason it is not accepted.
-std::optional<std::string> ParseCliNumber(std::string_view opt, const std::string& text, const NumberRule& rule,
-                                          double& out);
-// As ParseCliNumber; type_lo / type_hi are the target type's range.
-std::optional<std::string> ParseCliInteger(std::string_view opt, const std::string& text, const IntegerRule& rule,
-                                           long long type_lo, long long type_hi, long long& out);
 
 struct CliResult {
   enum class Status { kOk, kHelp, kError };
@@ -76,66 +32,85 @@ struct CliResult {
   std::string error;  // the reason (kError), without the tool prefix and suffix
 };
 
-class CliParser {
+// Exit status of bad usage and bad input of every tool.
+inline constexpr int kUsageExit = 2;
+
+namespace cli_detail {
+// The checks Cli::Add attaches to a number option: the whole text is a finite number, or a
+// decimal integer in [lo, hi] (the target type's range; rewritten as plain decimal digits,
+// so that a leading zero is never read as octal).
+CLI::Validator FloatText();
+CLI::Validator IntegerText(long long lo, long long hi);
+template <typename T>
+CLI::Validator NumberText() {
+  if constexpr (std::is_floating_point_v<T>) {
+    return FloatText();
+  } else {
+    constexpr long long kMax = std::numeric_limits<long long>::max();
+    return IntegerText(static_cast<long long>(std::numeric_limits<T>::min()),
+                       std::cmp_greater(std::numeric_limits<T>::max(), kMax) ? kMax
+                                                                             : static_cast<long long>(std::numeric_limits<T>::max()));
+  }
+}
+// One value per occurrence, every occurrence kept in order; `empty`: no default to show.
+CLI::Option* Repeatable(CLI::Option* option, bool empty);
+}  // namespace cli_detail
+
+class Cli {
  public:
-  // A custom option: applies its value, or returns the reason it is not accepted.
-  using Handler = std::function<std::optional<std::string>(const std::string& value)>;
+  // `tool` is the program name in the usage line and the prefix of every message;
+  // `description` opens --help, `footer` follows the options (the exit status).
+  Cli(std::string tool, const std::string& description, const std::string& footer = "");
+  Cli(const Cli&) = delete;
+  Cli& operator=(const Cli&) = delete;
 
-  CliParser(CliStyle style, std::function<void()> print_help);
-
-  // --name VALUE; the last one counts.
-  CliParser& Value(std::string name, std::string& target);
-  // --name VALUE, repeatable; appended in order.
-  CliParser& List(std::string name, std::vector<std::string>& target);
-  // --name: sets target to true.
-  CliParser& Flag(std::string name, bool& target);
-  CliParser& Number(std::string name, double& target, NumberRule rule);
-  CliParser& Number(std::string name, std::vector<double>& target, NumberRule rule);  // repeatable
-  CliParser& Number(std::string name, std::function<void(double)> set, NumberRule rule);
+  // --name bound to `target`: std::string (one value), bool (a flag), an integer or a
+  // floating-point number (one value), or a std::vector of strings or numbers (repeatable).
+  // Returns the CLI11 option for ->required(), ->check(...), ->delimiter(','), ...
   template <typename T>
-  CliParser& Integer(std::string name, T& target, IntegerRule rule);
-  CliParser& Custom(std::string name, Handler handler);
-  // After the arguments: "<name> is required" if the Value / List of `name` is empty
-  // (checked in the order of the Require calls).
-  CliParser& Require(const std::string& name);
+  CLI::Option* Add(const std::string& name, T& target, const std::string& help);
 
-  // Applies the arguments argv[1..argc) to the targets; stops at the first error or help.
-  [[nodiscard]] CliResult Parse(int argc, const char* const* argv) const;
+  CLI::App& app() { return app_; }
+
+  // Applies the arguments argv[1..argc) (for tests: never exits).
+  [[nodiscard]] CliResult Parse(int argc, const char* const* argv);
   // Parse; help: print it, exit 0; error: Fail.
-  void ParseOrExit(int argc, const char* const* argv) const;
-  // The line printed for an error: "<tool>: <reason>" plus " (see --help)" if the style says so.
+  void ParseOrExit(int argc, const char* const* argv);
+  [[nodiscard]] std::string Help() const;
+  // The line printed for bad usage: "<tool>: <reason> (see --help)".
   [[nodiscard]] std::string Message(const std::string& reason) const;
-  // Prints Message(reason) on stderr and exits with the style's error code.
+  // Prints Message(reason) on stderr and exits with kUsageExit.
   [[noreturn]] void Fail(const std::string& reason) const;
 
  private:
-  struct Option {
-    std::string name;
-    bool takes_value = true;
-    Handler apply;                // value (empty for a flag) -> error
-    std::function<bool()> empty;  // Value / List: is the target empty
-  };
-  CliParser& Add(Option option);
-  CliParser& AddInteger(std::string name, std::function<void(long long)> set, IntegerRule rule, long long type_lo,
-                        long long type_hi);
-  [[nodiscard]] const Option* Find(std::string_view name) const;
-
-  CliStyle style_;
-  std::function<void()> print_help_;
-  std::vector<Option> options_;
-  std::vector<std::size_t> required_;  // indices into options_
+  std::string tool_;
+  CLI::App app_;
 };
 
 template <typename T>
-CliParser& CliParser::Integer(std::string name, T& target, IntegerRule rule) {
-  static_assert(std::is_integral_v<T> && !std::is_same_v<T, bool>, "Integer needs an integer target");
-  constexpr long long kLlMax = std::numeric_limits<long long>::max();
-  constexpr long long type_lo = std::is_signed_v<T> ? static_cast<long long>(std::numeric_limits<T>::min()) : 0;
-  constexpr long long type_hi = std::cmp_greater(std::numeric_limits<T>::max(), kLlMax)
-                                    ? kLlMax
-                                    : static_cast<long long>(std::numeric_limits<T>::max());
-  return AddInteger(std::move(name), [&target](long long v) { target = static_cast<T>(v); }, std::move(rule), type_lo,
-                    type_hi);
+CLI::Option* Cli::Add(const std::string& name, T& target, const std::string& help) {
+  if constexpr (std::is_same_v<T, bool>) {
+    return app_.add_flag(name, target, help);
+  } else if constexpr (std::is_arithmetic_v<T>) {
+    return app_.add_option(name, target, help)->transform(cli_detail::NumberText<T>());
+  } else if constexpr (std::is_same_v<T, std::vector<double>>) {
+    return cli_detail::Repeatable(app_.add_option(name, target, help)->transform(cli_detail::NumberText<double>()),
+                                  target.empty());
+  } else if constexpr (std::is_same_v<T, std::vector<std::string>>) {
+    return cli_detail::Repeatable(app_.add_option(name, target, help), target.empty());
+  } else {
+    static_assert(std::is_same_v<T, std::string>, "Cli::Add: string, bool, number or a vector of them");
+    return app_.add_option(name, target, help);
+  }
 }
+
+// A number in [lo, hi] (`lo_open`: lo < value); message "not a number in [lo, hi]: 'text'".
+CLI::Validator InRange(double lo, double hi, bool lo_open = false);
+// A number above `lo` (lo < value); message "not a number above lo: 'text'".
+CLI::Validator Above(double lo);
+
+// The main() of a tool: runs `body` and returns its exit status; an InputError prints
+// "<tool>: <what>", any other std::exception "<tool>: error: <what>" on stderr, exit 2.
+int RunTool(const std::string& tool, const std::function<int()>& body);
 
 }  // namespace railproof::offline

@@ -1,34 +1,59 @@
-// Simple longitudinal train dynamics and the braking-supervision stand-in of the line
-// simulation (offline; SI units in double: m, s, m/s, m/s^2).
+// The one train-motion model of the offline tools: a point mass moving along the track.
 //
-// Dynamics (one point mass per train, per unit mass):
-//   a = traction - brake - g/1000 * (r(v) + i)
-//   traction in [0, accel_max] while v < max speed (constant maximum, no power limit),
-//   brake in [0, service_decel], or emergency_decel alone when the emergency brake is on,
-//   r(v) = a0 + a1*v + a2*v^2   specific running resistance in N/kN (= per mille of the
-//                                train's weight), v in km/h (Davis form),
-//   i = mean gradient in per mille under the train (+ rising), g = 9.81 m/s^2.
-// The acceleration is constant over one step (exact integration of a piecewise-constant
-// acceleration); a braking or coasting train stops at v = 0 and does not roll back (a
-// standing train holds its brake). Brakes act without delay: the free-running time is
-// accounted for in the supervision curves instead.
+// Forces per unit mass (accelerations, + forward; any length unit with seconds, the unit of
+// the gravity given):
+//   a = applied - r(v) - g i / 1000
+//   applied   traction in [0, accel_max] while v < max speed (constant maximum, no power
+//             limit), or minus a braking deceleration (service, or the emergency brake alone),
+//   r(v)      running resistance a0 + a1 v + a2 v^2 in N/kN (= per mille of the train's
+//             weight), v in km/h (Davis form; SI only),
+//   g i/1000  gravity on a gradient of i per mille (+ rising): GradeDecel.
+// Motion under a constant acceleration is exact: Advance over a time, SpeedAfter and TimeOver
+// over a distance, TimeToCover a distance; a braking or coasting train stops at v = 0 and does
+// not roll back (a standing train holds its brake). Braking curves: StoppingDistance and its
+// inverse CurveSpeed (a deceleration after a free-running time at constant speed). Speed
+// limits act on the whole train: RunningLine::ForEachLimitActing (line.hpp).
 //
-// Braking supervision (stand-in until the braking issue; ASM-013 is what it discharges):
-// the on-board unit supervises its stop limit L with its safe front x (estimated front +
-// length correction) and d = L - x:
-//   service curve  v_s(d) = speed from which the train stops within d - margin with
-//                  deceleration beta_s' after free_running_s at constant speed,
-//   emergency curve v_e(d) = the same with beta_e', emergency_free_running_s and no margin,
-//   beta' = nominal deceleration minus g/1000 * (steepest falling gradient up to L).
+// Every offline train motion is this model, each integrated the way its purpose needs:
+//   line simulator (sim)      fixed time steps (Advance of NetAcceleration) with the driver and
+//                             the supervision stand-in in the loop; mean gradient under the
+//                             train, running resistance; SI units, gravity kGravity;
+//   margin verification (br)  the worst case integrated exactly over the pieces of the most
+//                             falling gradient under the train: run-up under traction
+//                             (Advance, SpeedAfter, TimeOver), then braking to a stop
+//                             (SpeedAfter, StoppingDistance); the falsifier in 10 ms steps
+//                             (Advance) with the runtime supervision in the loop; no running
+//                             resistance (it would only help); mm, the runtime's gravity. The
+//                             braking patterns the margins are measured against are the
+//                             RUNTIME's integer patterns (br::PatternCalculator), called as they
+//                             are: they are what is verified, not part of this model;
+//   warning-time study (lc)   the run between two stops on a 1 m grid: the speed envelope of
+//                             accelerating at accel_max, the limits under the train and braking
+//                             at the service deceleration ahead of lower limits and the stop
+//                             (SpeedAfter), times by TimeOver, positions in time by Advance and
+//                             TimeToCover; gradients and resistance not modelled (its
+//                             documented model); mm.
+// Not this model: the Box2D wheel-rail simulator (ra) is multi-body creep physics (car body,
+// bogies, wheelsets, slip-dependent adhesion per wheelset): slip and slide, its subject, do
+// not exist for a point mass.
+//
+// Braking supervision stand-in of the line simulation (ASM-013 is what it discharges): the
+// on-board unit supervises its stop limit L with its safe front x (estimated front + length
+// correction) and d = L - x:
+//   service curve  v_s(d) = CurveSpeed(d - margin, beta_s', free_running_s),
+//   emergency curve v_e(d) = CurveSpeed(d, beta_e', emergency_free_running_s),
+//   beta' = nominal deceleration minus GradeDecel(steepest falling gradient up to L).
 // The driving controller never aims above v_s (service brake follows it); if v > v_e the
 // emergency brake is applied and held until standstill. An unusable authority (no limit,
 // expired, or radio link down) means standstill: emergency brake.
+//
+// Offline module.
 #pragma once
-
-#include <cstdint>
 
 namespace railproof::offline {
 
+// Gravity of the line simulation (m/s^2). The margin verification uses the runtime's
+// (spec/parameters/br.yaml gravity_mm_s2), the quantity its patterns are computed with.
 inline constexpr double kGravity = 9.81;
 
 // Running resistance r(v) = a0 + a1 v + a2 v^2 in N/kN, v in km/h. Default: a typical
@@ -55,28 +80,45 @@ struct Control {
   bool emergency = false;      // overrides both
 };
 
+// Front position and speed (m and m/s, or mm and mm/s).
 struct Motion {
-  double position_m = 0.0;  // true front
-  double speed_mps = 0.0;   // >= 0
+  double position = 0.0;
+  double speed = 0.0;  // >= 0
 };
 
-// Resistance deceleration g*r(v)/1000 in m/s^2.
+// Resistance deceleration g r(v) / 1000 in m/s^2.
 double ResistanceDecel(const Resistance& r, double speed_mps);
 
-// Net acceleration for a control, speed and mean gradient (per mille, + rising).
+// Deceleration by gravity on a gradient of `gradient_permille` (+ rising; negative on a
+// falling gradient) in the unit of `gravity`: gravity * i / 1000.
+double GradeDecel(double gradient_permille, double gravity = kGravity);
+
+// Net acceleration (m/s^2) for a control, speed and mean gradient (per mille, + rising).
 double NetAcceleration(const TrainPerformance& perf, const Control& control, double speed_mps,
                        double gradient_permille);
 
-// Advances the motion by dt seconds with constant net acceleration; stops at v = 0 (no
-// rolling back); a standing train with net acceleration <= 0 stays.
-Motion Advance(const Motion& m, double net_accel_mps2, double dt_s);
+// Advances the motion by dt seconds with constant acceleration a; stops at v = 0 (no rolling
+// back); a standing train with a <= 0 stays.
+Motion Advance(const Motion& m, double a, double dt_s);
 
-// Largest speed from which a train stops within `distance_m` with deceleration `decel`
-// after `free_running_s` at constant speed: v t + v^2 / (2 b) = d, v = b (sqrt(t^2 + 2d/b) - t).
-// 0 for d <= 0 or b <= 0.
-double CurveSpeed(double distance_m, double decel_mps2, double free_running_s);
+// Speed after `distance` at constant acceleration a from `speed`: sqrt(v^2 + 2 a d), 0 if the
+// train stops before.
+double SpeedAfter(double speed, double a, double distance);
+
+// Time (s) to run `distance` at constant acceleration from speed v0 to speed v1:
+// 2 d / (v0 + v1) (v0 + v1 > 0).
+double TimeOver(double distance, double v0, double v1);
+
+// Time (s) at which a train at `speed` with constant acceleration a has run `distance`
+// (>= 0); +infinity if it stops before.
+double TimeToCover(double speed, double a, double distance);
 
 // Distance to stop from v: v t + v^2 / (2 b).
-double StoppingDistance(double speed_mps, double decel_mps2, double free_running_s);
+double StoppingDistance(double speed, double decel, double free_running_s);
+
+// Largest speed from which a train stops within `distance` with deceleration `decel`
+// after `free_running_s` at constant speed: v t + v^2 / (2 b) = d, v = b (sqrt(t^2 + 2d/b) - t).
+// 0 for d <= 0 or b <= 0.
+double CurveSpeed(double distance, double decel, double free_running_s);
 
 }  // namespace railproof::offline

@@ -8,6 +8,7 @@
 // and the ground rely on them (REQ-MB-020), so a hand-edited or stale JSON is rejected.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <filesystem>
 #include <optional>
@@ -120,6 +121,19 @@ struct RunningLine {
   [[nodiscard]] std::int64_t SpeedLimitAt(std::int64_t pos_mm) const;
   [[nodiscard]] const Station* FindStation(std::string_view name) const;
   [[nodiscard]] const Points* FindPoints(std::string_view points_id) const;
+
+  // Calls f(i) for every speed limit i acting on a train occupying [rear, front]: a limit on
+  // [begin, end) acts from its begin reaching the front until its end leaving the rear
+  // (begin <= front, rear < end). Positions in mm, or in the unit of mm_per_unit mm (1000: m).
+  template <typename F>
+  void ForEachLimitActing(double rear, double front, F&& f, double mm_per_unit = 1.0) const {
+    for (std::size_t i = 0; i < speed_limits.size(); ++i) {
+      const Section& s = speed_limits[i].section;
+      if (static_cast<double>(s.begin_mm) / mm_per_unit <= front && rear < static_cast<double>(s.end_mm) / mm_per_unit) {
+        f(i);
+      }
+    }
+  }
 };
 
 struct Line {

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "railproof/br/patterns.hpp"
+#include "railproof/offline/line.hpp"
 
 namespace railproof::offline {
 
@@ -72,6 +73,12 @@ TrainType LoadTrainType(const std::filesystem::path& path);
 // The pattern values of the runtime (br::TrainData): the maximum of every range,
 // overspeed in mm/s rounded up.
 br::TrainData ToTrainData(const TrainType& t);
+
+// A running line as the runtime braking module's profile (br::PatternCalculator::SetProfile):
+// its gradients, and its speed limits as restrictions (mm/s, km/h rounded up), each capped at
+// cap_mm_s (the train's maximum speed; 0: no cap).
+std::vector<br::GradientSegment> GradientProfile(const RunningLine& rl);
+std::vector<br::RestrictionSegment> PermittedProfile(const RunningLine& rl, std::int64_t cap_mm_s);
 
 // Violations of the design rule of the pattern decelerations (REQ-BR-010): beta_e above the
 // lowest real emergency deceleration, beta_n7 above beta_e. Empty when the rule holds.

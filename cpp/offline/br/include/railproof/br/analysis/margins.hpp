@@ -18,6 +18,8 @@
 //                 brake: SupervisedSpeed(v_m) <= EmergencyPatternSpeed(x_s, L, E, E); the
 //                 standstill state (v_m = 0, standstill, v_s = 0) included. The true speed is
 //                 capped at the train's maximum speed.
+// Physics         the offline train-motion model (railproof/offline/dynamics.hpp) without
+//                 running resistance, integrated exactly over the gradient pieces.
 // Worst case      from the admissible check: traction accel_max for the rest of the cycle
 //                 (phase), the next check commands the emergency brake, reaction_ms and the
 //                 free-running time (still under traction), then the real emergency
@@ -185,6 +187,11 @@ class MarginModel {
   // running, then braking with beta until standstill. Returns the trajectory (points if asked).
   [[nodiscard]] Trajectory Simulate(double true_front_mm, double true_speed_mm_s, const Adversary& adv,
                                     bool keep_points) const;
+  // The gravity of the physics (mm/s^2): the runtime's (gravity_mm_s2).
+  [[nodiscard]] double Gravity() const;
+  // Deceleration by gravity on gradient piece `piece` (piece_gradient) with the adversary's
+  // gradient error (mm/s^2; negative on a falling gradient).
+  [[nodiscard]] double Grade(std::size_t piece, const Adversary& adv) const;
 
  private:
   const offline::RunningLine* rl_;

@@ -12,12 +12,12 @@
 // It also counts the trains whose protection pattern would have braked them for a crossing
 // (the closure confirmation later than the pattern's first brake command, REQ-LC-015).
 //
-// Kinematic model (documented in spec/timetables/README.md): per section between two stops
-// the train accelerates at its accel_max up to its cruising speed (cruise factor x the
+// Kinematic model (documented in spec/timetables/README.md), the offline train-motion model
+// (railproof/offline/dynamics.hpp) without gradients and resistance: per section between two
+// stops the train accelerates at its accel_max up to its cruising speed (cruise factor x the
 // permitted speed: the line limit applying until the rear has left it, lowered to the
 // supervision's ceiling on the line profile, capped at the train's maximum speed), brakes
-// at the lower bound of its service deceleration for lower limits
-// and for the stop; gradients are not modelled. Dwell, departure delays, cruise factor,
+// at the lower bound of its service deceleration for lower limits and for the stop. Dwell, departure delays, cruise factor,
 // radio delays, barrier travel and clock errors are drawn from the timetable's seed.
 //
 // Offline module (may allocate and throw offline::InputError "<file>: <entry>: <reason>").
@@ -124,10 +124,6 @@ Timetable LoadTimetable(const std::filesystem::path& path);
 void CheckTimetable(const Timetable& tt, const offline::Line& line, const std::map<std::string, TrainType>& trains);
 
 // ---- kinematics ------------------------------------------------------------------------------
-
-// The permitted-speed profile of a running line for a train: the line limits as restriction
-// segments (mm/s, km/h rounded up), each capped at cap_mm_s (the train's maximum speed; 0: no cap).
-std::vector<br::RestrictionSegment> PermittedProfile(const offline::RunningLine& rl, std::int64_t cap_mm_s);
 
 // Fixed treadle: the distance before `near_mm` from which a train running at the permitted
 // speed of `profile` (the fastest train at line speed) needs exactly `warning_ms` to reach
