@@ -14,7 +14,9 @@ set(_tg ${RAILPROOF_SOURCE_DIR}/testgen/railproof_testgen)
 # what every testgen command runs (the command line and its error types)
 set(_tg_base ${_tg}/__init__.py ${_tg}/__main__.py ${_tg}/errors.py ${_tg}/spec.py)
 set(_tg_spin ${_tg_base} ${_tg}/spin.py)
-file(GLOB _tg_engine CONFIGURE_DEPENDS ${_tg}/vectorgen.py ${_tg}/vectors.py)
+# the vector engine and what it finds a model's capability part with (the registry)
+set(_tg_engine ${_tg}/vectors.py ${_tg}/registry.py ${_tg}/capabilities/__init__.py
+    ${RAILPROOF_SOURCE_DIR}/spec/capabilities.yaml ${RAILPROOF_SOURCE_DIR}/spec/schemas/capabilities.schema.json)
 
 # SPIN and vector generation are memory- and CPU-heavy: at most two at a time (each runs its
 # own searches on two worker threads).
