@@ -33,6 +33,7 @@ from __future__ import annotations
 
 import importlib
 import json
+from abc import ABC, abstractmethod
 import os
 import re
 from concurrent.futures import ThreadPoolExecutor
@@ -84,10 +85,11 @@ class Configuration:
         return walks if self.walks == 1 else max(1, walks // self.walks)
 
 
-class Part:
+class Part(ABC):
     """A capability's part of vector generation: capabilities/<cap>.py defines PART, an instance
-    of a subclass that sets prefix and configurations and implements bounds, parse_events,
-    to_steps, observed_requirements and header; the other members have the common default.
+    of a subclass that sets prefix and configurations and implements the abstract methods
+    (bounds, parse_events, to_steps, observed_requirements, header); the other members have
+    the common default.
     A configuration is named by its define (None: the model's default configuration)."""
     prefix: str = ""                  # vector ids begin <prefix>-<KIND>-
     configurations: tuple = ()        # Configuration, the model's default one first
@@ -104,20 +106,25 @@ class Part:
         raise KeyError(define)
 
     # what the capability implements
+    @abstractmethod
     def bounds(self, model: Path, params_pml: Path) -> dict:
-        raise NotImplementedError
+        """The model bounds the part needs (model_bounds of the generated <model>_params.pml)."""
 
+    @abstractmethod
     def parse_events(self, text: str) -> list:
-        raise NotImplementedError
+        """The events of a replay or walk (spin's output: the model's @IN/@OUT lines)."""
 
+    @abstractmethod
     def to_steps(self, events: list, bounds: dict, define) -> list:
-        raise NotImplementedError
+        """The events as the steps of a vector (the capability's schema)."""
 
+    @abstractmethod
     def observed_requirements(self, steps: list) -> set:
-        raise NotImplementedError
+        """The requirements a run shows (added to a goal's own)."""
 
+    @abstractmethod
     def header(self, target: "Target", define) -> dict:
-        raise NotImplementedError
+        """The header line of the file of a configuration (Target.header and the part's fields)."""
 
     # the common rules, overridden where a capability has its own
     def walk_length(self, bounds: dict, define) -> int | None:
@@ -281,8 +288,8 @@ class Generation:
         self.walks, self.jobs = walks, max(1, jobs)
         self.walk_steps = walk_steps if walk_steps is not None else part.walk_steps
         if walk_steps is not None and part.walk_steps is None:
-            raise SpecError(self.model, "--walk-steps", "the model ends its random walks itself "
-                                                        f"(-D{' -D'.join(part.walk_defines)})")
+            raise SpecError(self.model, "--walk-steps", f"the model ends its random walks itself (capability "
+                                                        f"{capability}: no walk length in SPIN statements)")
         ann = spin_mod.parse_annotations(self.model)
         if not ann.goals:
             raise SpecError(self.model, "-", "no // @goal annotations: nothing to generate")
@@ -386,26 +393,32 @@ class Generation:
 
     # ---- the whole run --------------------------------------------------------------------
     def run(self) -> dict:
-        part, target, ann = self.part, self.target, self.ann
         self.workdir.mkdir(parents=True, exist_ok=True)
-        outcomes = self.search_plan()
-        per_config = {c.define: [] for c in part.configurations}
+        per_config = {c.define: [] for c in self.part.configurations}  # the vectors of each configuration
+        coverage, problems = self.goal_vectors(self.search_plan(), per_config)
+        self.walk_vectors(per_config)
+        return self.write(coverage, per_config, problems)
+
+    def goal_vectors(self, outcomes: dict, per_config: dict):
+        """The vectors of the reached goals and the coverage record of every goal; the problems
+        of the justifications (an unreachable goal without one, one for a goal that is not)."""
+        part, target = self.part, self.target
         coverage, problems = [], []
 
-        def goal_vectors(g, define, outcome):
+        def made(g, define, outcome):
             kind = "boundary" if any(w in g.label.lower() for w in part.boundary_words) else "trap"
-            made = part.vectors(target, define, outcome.events, part.vector_id(kind, define, g.gid), kind,
+            vecs = part.vectors(target, define, outcome.events, part.vector_id(kind, define, g.gid), kind,
                                 g.gid, None, g.requirements)
-            per_config[define].extend(made)
-            return [v["id"] for v in made]
+            per_config[define].extend(vecs)
+            return [v["id"] for v in vecs]
 
-        for g in ann.goals:
+        for g in self.ann.goals:
             home = outcomes[(g.number, g.config)]
             where = part.configuration(g.config).name
             entry = {"id": g.gid, "label": g.label, "requirements": g.requirements, "status": home.status,
                      "configuration": where, "vectors": [], "justification": None, "states_searched": None}
             if home.status == REACHED:
-                entry["vectors"] = goal_vectors(g, g.config, home)
+                entry["vectors"] = made(g, g.config, home)
                 _progress(f"{g.gid} [{where}] reached in {len(home.events)} step(s): {g.label}")
             else:
                 entry["justification"] = self.justifications.get(g.gid)
@@ -414,10 +427,10 @@ class Generation:
                 if not entry["justification"]:
                     problems.append(f"{self.justification_file}: {g.gid}: goal unreachable in {where} "
                                     f"({g.label}) and not justified (model {target.rel})")
-            for v in ann.variants if g.config is None else []:
+            for v in self.ann.variants if g.config is None else []:
                 found = outcomes.get((g.number, v.define))
                 if found is not None and found.status == REACHED:
-                    entry.setdefault("variant_vectors", []).extend(goal_vectors(g, v.define, found))
+                    entry.setdefault("variant_vectors", []).extend(made(g, v.define, found))
                     entry["variant"] = v.define
                     _progress(f"{g.gid} reached in variant {v.define} in {len(found.events)} step(s)")
             coverage.append(entry)
@@ -426,17 +439,21 @@ class Generation:
             if gid not in unreachable:
                 what = "reached" if any(c["id"] == gid for c in coverage) else "not a goal of the model"
                 problems.append(f"{self.justification_file}: {jid}: justifies goal {gid}, which is {what}")
+        return coverage, problems
 
-        jobs = [(c.define, seed) for c in part.configurations for seed in range(1, c.walk_count(self.walks) + 1)]
-        _progress(f"{len(jobs)} random walks ({', '.join(f'{c.walk_count(self.walks)} in {c.name}' for c in part.configurations if c.walks)})")
+    def walk_vectors(self, per_config: dict):
+        """The random walks of every configuration the part gives walks to."""
+        part, target = self.part, self.target
+        counts = {c.define: c.walk_count(self.walks) for c in part.configurations}
+        jobs = [(define, seed) for define, n in counts.items() for seed in range(1, n + 1)]
+        _progress(f"{len(jobs)} random walks (" + ", ".join(f"{n} in {part.configuration(d).name}"
+                                                           for d, n in counts.items() if n) + ")")
         with self.pool() as ex:
             walked = list(ex.map(self.walk, jobs))
         for (define, seed), events in walked:
-            c = part.configuration(define)
-            extra = target.property_requirements(define) if c.walk_evidence else set()
+            extra = target.property_requirements(define) if part.configuration(define).walk_evidence else set()
             per_config[define].extend(part.vectors(target, define, events, part.vector_id("random", define, f"S{seed}"),
                                                    "random", None, seed, extra))
-        return self.write(coverage, per_config, problems)
 
     def write(self, coverage, per_config, problems) -> dict:
         part, stem = self.part, self.model.stem
@@ -464,7 +481,8 @@ class Generation:
             atomic_write(self.out_dir / name, text)
         atomic_write(self.out_dir / f"{stem}.coverage.json", json.dumps(cov, indent=2, sort_keys=True) + "\n")
         _progress(f"goal coverage {reached}/{len(coverage)} reached, {cov['unreachable_justified']} unreachable "
-                  f"justified; {len(all_vecs)} vectors written ({', '.join(f'{n}: {k}' for n, k in cov['files'].items())})")
+                  f"justified; {len(all_vecs)} vectors written ("
+                  + ", ".join(f"{n}: {k}" for n, k in cov["files"].items()) + ")")
         if problems:
             raise PipelineError(f"{self.model.name}: goal coverage: " + "; ".join(problems))
         return cov

@@ -278,7 +278,8 @@ class Counters(vectors.Part):
     def header(self, target, define):
         b = target.bounds
         return target.header(configuration=self.configuration(define).name,
-                             parameters={"limit": b["wide_limit" if define == "WIDE" else "limit"], "steps": b["steps"]})
+                             parameters={"limit": b["wide_limit" if define == "WIDE" else "limit"],
+                                         "steps": b["steps"]})
 
 
 def _generate(tmp_path, part=None, spec=FIX / "spec", walks=3, out=None):

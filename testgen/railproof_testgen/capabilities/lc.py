@@ -426,14 +426,16 @@ class LevelCrossing(Part):
             elif kind == "ua":
                 cur["ua"].append({"c": g[0], "age": g[1]})
             elif kind == "centre":
-                cur["centre"] = {"clr": g[0], "c": [dict(zip(("st", "p", "a", "x", "sp", "sa", "cf"), g[1 + 7 * c:8 + 7 * c]))
-                                                    for c in (0, 1)]}
+                cur["centre"] = {"clr": g[0],
+                                 "c": [dict(zip(("st", "p", "a", "x", "sp", "sa", "cf"), g[1 + 7 * c:8 + 7 * c]))
+                                       for c in (0, 1)]}
             elif kind == "ds":
                 cur["ds"].append({"c": g[0], "age": g[1]})
             elif kind == "clk":
                 cur["clk"][g[0]] = g[1]
             elif kind == "gctrl":
-                cur["gctrl"][g[0]] = dict(zip(("cs", "wa", "new", "pres", "pst", "act", "ck", "ack", "acc", "sack"), g[1:]))
+                cur["gctrl"][g[0]] = dict(zip(("cs", "wa", "new", "pres", "pst", "act", "ck", "ack", "acc", "sack"),
+                                              g[1:]))
             elif kind == "move":
                 cur["move"] = (g[0], g[1])
                 ticks.append(cur)
@@ -495,7 +497,8 @@ class LevelCrossing(Part):
             "train": {"id": TRAIN_ID, "length_mm": b["train_len"] * CELL_MM, "accel_max_mm_s2": ACCEL_MM_S2},
             "other_train_id": OTHER_TRAIN_ID,
             "crossings": crossings(b, config),
-            "restrictions": [{"begin_mm": 0, "end_mm": (b["track"] + 2) * CELL_MM, "limit_mm_s": b["vmax"] * SPEED_MM_S}],
+            "restrictions": [{"begin_mm": 0, "end_mm": (b["track"] + 2) * CELL_MM,
+                              "limit_mm_s": b["vmax"] * SPEED_MM_S}],
             "protection": {"request_lead_ms": t["LEAD"] * TICK_MS, "confirmation_max_age_ms": t["CMA"] * TICK_MS,
                            "protection_offset_mm": t["PO"] * CELL_MM, "lookahead_mm": 5_000_000},
             "controller": {"barrier_lowering_ms": t["LOWER"] * TICK_MS, "barrier_timeout_ms": t["TO"] * TICK_MS,
