@@ -144,7 +144,7 @@ function(railproof_test_set name)
   add_library(${objs} OBJECT ${A_SOURCES})
   # the test objects see the headers of what they test (and GoogleTest); they are compiled once
   target_link_libraries(${objs} PRIVATE ${links} railproof_testing GTest::gtest railproof_options)
-  add_dependencies(${objs} railproof_gen_lines railproof_gen_trains)
+  add_dependencies(${objs} railproof_gen_lines railproof_gen_trains railproof_gen_timetables)
   set(exe railproof_${name}_tests)
   add_executable(${exe} $<TARGET_OBJECTS:${objs}>)
   target_link_libraries(${exe} PRIVATE ${links} railproof_testing GTest::gtest_main railproof_options)

@@ -8,14 +8,16 @@
 #               with goal coverage; per capability with proofs: the SMT proofs; the studies
 #               the offline modules register (railproof_study); the registry and layout checks.
 #   evidence  : the test suite's results (one ctest run, JUnit), tool versions, trace.json and
-#               the rendered evidence package in ${CMAKE_BINARY_DIR}/evidence.
+#               the rendered evidence package in ${CMAKE_BINARY_DIR}/evidence (verdict and
+#               reasons in evidence/evidence.json).
 set(RAILPROOF_VECTOR_DIR ${RAILPROOF_RESULTS_DIR}/vectors)
 set(_tg ${RAILPROOF_SOURCE_DIR}/testgen/railproof_testgen)
-# what every testgen command runs (the command line and its error types)
-set(_tg_base ${_tg}/__init__.py ${_tg}/__main__.py ${_tg}/errors.py ${_tg}/spec.py)
+# what every testgen command runs (the command line and its error types); each step adds the
+# modules it runs (the command line imports only the module of the command)
+set(_tg_base ${_tg}/__init__.py ${_tg}/__main__.py ${_tg}/errors.py)
 set(_tg_spin ${_tg_base} ${_tg}/spin.py)
 # the vector engine and what it finds a model's capability part with (the registry)
-set(_tg_engine ${_tg}/vectors.py ${_tg}/registry.py ${_tg}/capabilities/__init__.py
+set(_tg_engine ${_tg}/vectors.py ${_tg}/spec.py ${_tg}/registry.py ${_tg}/capabilities/__init__.py
     ${RAILPROOF_SOURCE_DIR}/spec/capabilities.yaml ${RAILPROOF_SOURCE_DIR}/spec/schemas/capabilities.schema.json)
 
 # SPIN and vector generation are memory- and CPU-heavy: at most two at a time (each runs its
@@ -64,7 +66,8 @@ foreach(cap ${RAILPROOF_CAPABILITIES})
       OUTPUT ${_proofs}
       COMMAND ${RAILPROOF_TESTGEN} proofs --spec ${RAILPROOF_SOURCE_DIR}/spec
               --proofs ${RAILPROOF_SOURCE_DIR}/proofs --out ${RAILPROOF_RESULTS_DIR}/proofs
-      DEPENDS ${_cap_proofs} ${RAILPROOF_PARAM_FILES} ${RAILPROOF_TRAIN_FILES} ${_tg_base} ${_tg}/proofs.py
+      DEPENDS ${_cap_proofs} ${RAILPROOF_PARAM_FILES} ${RAILPROOF_TRAIN_FILES} ${_tg_base} ${_tg}/spec.py
+              ${_tg}/proofs.py
       COMMENT "proofs: SMT obligations of proofs/${cap} from spec/, replayed by z3 and cvc5" VERBATIM)
     list(APPEND _proof_outputs ${_proofs})
   endif()
@@ -155,19 +158,34 @@ add_custom_command(
   COMMAND ${RAILPROOF_TESTGEN} trace --spec ${RAILPROOF_SOURCE_DIR}/spec --src ${RAILPROOF_SOURCE_DIR}
           --results ${RAILPROOF_RESULTS_DIR} --out ${_trace}
   DEPENDS ${_spin_outputs} ${_vector_outputs} ${_proof_outputs} ${_study_outputs} ${_traced_sources}
-          ${_proof_sources} ${RAILPROOF_SPEC_FILES} ${_tg_base} ${_tg}/trace.py ${_tg}/registry.py
+          ${_proof_sources} ${RAILPROOF_SPEC_FILES} ${RAILPROOF_SPEC_TOOL_FILES} ${_tg}/trace.py
+          ${_tg}/registry.py
   COMMENT "trace: requirement <-> property/vector/code/test links" VERBATIM)
 add_custom_target(railproof_trace ALL DEPENDS ${_trace})
 
+# The evidence reads every result above (it never runs a test: the JUnit files come from the
+# test-results step) and the design notes; it is rendered again when any of them changes.
 set(_manifest ${CMAKE_BINARY_DIR}/evidence/manifest.json)
 file(GLOB_RECURSE _evidence_sources CONFIGURE_DEPENDS ${RAILPROOF_SOURCE_DIR}/evidence/*)
-file(GLOB _evidence_py CONFIGURE_DEPENDS ${_tg}/evidence*.py ${_tg}/evidence/*.py)
+file(GLOB_RECURSE _evidence_py CONFIGURE_DEPENDS ${_tg}/evidence/*.py)
+file(GLOB _design_notes CONFIGURE_DEPENDS ${RAILPROOF_SOURCE_DIR}/spec/design/*.md)
+set(_evidence_command ${RAILPROOF_TESTGEN} evidence --spec ${RAILPROOF_SOURCE_DIR}/spec --results ${RAILPROOF_RESULTS_DIR}
+    --src ${RAILPROOF_SOURCE_DIR} --out ${CMAKE_BINARY_DIR}/evidence)
 add_custom_command(
   OUTPUT ${_manifest}
-  COMMAND ${RAILPROOF_TESTGEN} evidence --spec ${RAILPROOF_SOURCE_DIR}/spec --results ${RAILPROOF_RESULTS_DIR}
-          --src ${RAILPROOF_SOURCE_DIR} --out ${CMAKE_BINARY_DIR}/evidence --tool-versions ${_tools}
-  DEPENDS ${_trace} ${_test_stamp} ${_tools} ${_evidence_sources} ${_evidence_py}
+  COMMAND ${_evidence_command}
+  DEPENDS ${_trace} ${_test_stamp} ${_tools} ${_layout} ${RAILPROOF_RESULTS_DIR}/registry.json
+          ${_spin_outputs} ${_vector_outputs} ${_proof_outputs} ${_study_outputs}
+          ${RAILPROOF_SPEC_FILES} ${_design_notes} ${_evidence_sources} ${_evidence_py} ${_tg_base}
+          ${_tg}/spec.py ${_tg}/toolversions.py
   COMMENT "evidence: rendering the assessor's package (Sphinx + sphinx-needs)" VERBATIM)
+# After a failed test suite the package is still rendered, from the results the failed run
+# left, with the verdict FAIL and its reasons (./railproof does this; it never depends on the
+# suite's success stamp).
+add_custom_target(evidence-after-failure
+  COMMAND ${_evidence_command}
+  DEPENDS ${_trace} ${_tools} ${_layout}
+  COMMENT "evidence: rendering the assessor's package after a failed test suite" VERBATIM)
 add_custom_target(evidence DEPENDS ${_manifest})
 
 # ---- pipeline checks in the test suite (they read the build's results) -----------------------

@@ -53,6 +53,7 @@ needs_types = [
     {"directive": "mut", "title": "Mutant model", "prefix": "MUT_", "color": "#D9C9F2", "style": "node"},
     {"directive": "vec", "title": "Conformance vector", "prefix": "VEC_", "color": "#DCEFD0", "style": "node"},
     {"directive": "res", "title": "Analysis result", "prefix": "RES_", "color": "#F2E1C9", "style": "node"},
+    {"directive": "fault", "title": "Seeded fault", "prefix": "FAULT_", "color": "#F2C9D9", "style": "node"},
 ]
 needs_id_regex = r"^[A-Za-z][A-Za-z0-9_-]{2,}$"   # no dots: sphinx-needs uses ID.part
 needs_id_required = True
@@ -88,6 +89,9 @@ needs_extra_options = [
     {"name": "conformance", "description": "result of replaying a vector against the C++ implementation"},
     {"name": "analysis", "description": "analysis result file"},
     {"name": "outcome", "description": "pass or fail of an analysis against its target"},
+    {"name": "capability", "description": "capability of the registry a seeded fault belongs to"},
+    {"name": "kill_runs", "description": "how the registry says a seeded fault is killed (vectors, unit)"},
+    {"name": "killers", "description": "number of tests that failed with the seeded fault active"},
 ]
 
 needs_extra_links = [
@@ -99,6 +103,7 @@ needs_extra_links = [
     {"option": "replays", "outgoing": "replays vector", "incoming": "replayed by"},
     {"option": "quantifies", "outgoing": "quantifies", "incoming": "quantified by"},
     {"option": "targets", "outgoing": "must be killed by", "incoming": "kills mutant"},
+    {"option": "killed_by", "outgoing": "killed by", "incoming": "kills seeded fault"},
 ]
 
 needs_table_style = "DATATABLES"

@@ -49,7 +49,7 @@
  * Configurations (-D): default = two parallel start points (verification and trap
  * goals; TRAPS adds the goal flags); ONE_START = one start point (a boundary variant:
  * every property is verified in it too, and it supplies the vectors of
- * readhesion.one_start.jsonl); WALK stops after MODEL_CYCLES cycles (random-walk vectors).
+ * ra.one_start.jsonl); WALK stops after MODEL_CYCLES cycles (random-walk vectors).
  *
  * Annotations read by testgen: see models/tg.pml.
  */
@@ -571,7 +571,7 @@ ltl REQ_RA_012_balise { [] !v_balise }
 // @property REQ_RA_013_sensor REQ-RA-013 : an IMU or TG failure gives in the same cycle the stopped state with the failure as reason (IMU checked first), the stop demand and the invalid position, and discards every candidate
 ltl REQ_RA_013_sensor { [] !v_sensor }
 
-// @variant ONE_START start_points=1 : one start point (parallel_start_points = 1): every property is verified with a single candidate too, and the configuration supplies the vectors of readhesion.one_start.jsonl
+// @variant ONE_START start_points=1 : one start point (parallel_start_points = 1): every property is verified with a single candidate too, and the configuration supplies the vectors of ra.one_start.jsonl
 
 // @mutant MUTANT_TIMEOUT_OFF_BY_ONE violates REQ_RA_007_timeout : a candidate times out only above t_max + 1 (C++ FAULT_RA_TIMEOUT_OFF_BY_ONE)
 // @mutant MUTANT_CONFIRM_TWO violates REQ_RA_006_readhesion : re-adhesion adopted after MODEL_CONFIRM - 1 confirming cycles (C++ FAULT_RA_CONFIRM_TWO)

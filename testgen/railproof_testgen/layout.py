@@ -17,7 +17,7 @@ Rules, each violation printed as ``file-or-target: entry: reason`` (exit 1 if an
    common module links neither side;
 3. a runtime unit-test executable (test:runtime) links no offline module;
 4. a file under cpp/runtime includes no offline or test header (railproof/offline/,
-   railproof/sim/, railproof/<cap>/offline/, railproof/testing/), and a file of one side
+   railproof/sim/, railproof/<cap>/analysis/, railproof/testing/), and a file of one side
    includes no header of the other side (railproof/<cap>/wayside/ from an onboard file, ...).
    The compiler enforces the rest: a module sees only the headers of what it links.
 """
@@ -32,8 +32,8 @@ from .errors import PipelineError
 
 RUNTIME_EXTERNAL = {"PkgConfig::SODIUM"}
 SIDES = ("common", "onboard", "wayside")
-_INCLUDE = re.compile(r'^\s*#\s*include\s+"(railproof/[^"]+)"', re.M)
-_FORBIDDEN_IN_RUNTIME = re.compile(r"^railproof/(offline|sim|testing)/|^railproof/[a-z]{2}/offline/")
+_INCLUDE = re.compile(r'^[ \t]*#[ \t]*include[ \t]+"(railproof/[^"]+)"', re.M)
+_FORBIDDEN_IN_RUNTIME = re.compile(r"^railproof/(offline|sim|testing)/|^railproof/[a-z]{2}/analysis/")
 
 
 def _kind(entry: str):

@@ -53,14 +53,13 @@ Rules after the schema (entry names such as ``balises[B7]`` or ``gradients[3]``)
 """
 from __future__ import annotations
 
-import json
-import sys
 from decimal import Decimal, InvalidOperation
 from pathlib import Path
 
 from . import spec as spec_mod
 from . import validate as vmod
 from .errors import SpecError
+from .validate import label as _label
 
 SUB = "lines"
 SCHEMA_FILE = "line.schema.json"
@@ -82,49 +81,6 @@ def _m(mm):
 
 def _sec(a, b):
     return f"[{_m(a)}, {_m(b)}) m"
-
-
-def _label(section, item, index):
-    if isinstance(item, dict):
-        for key in ("id", "name"):
-            v = item.get(key)
-            if isinstance(v, (str, int)) and not isinstance(v, bool) and v != "":
-                return f"{section}[{v}]"
-    return f"{section}[{index}]"
-
-
-def _schema_entry(data, path):
-    """(entry, where) for a schema error at `path` inside `data`."""
-    if not path:
-        return "-", ""
-    entry, node, rest = [], data, list(path)
-    consumed = 0
-    i = 0
-    while i < len(rest):
-        key = rest[i]
-        nxt = rest[i + 1] if i + 1 < len(rest) else None
-        if isinstance(key, str) and isinstance(nxt, int) and isinstance(node, dict) \
-                and isinstance(node.get(key), list):
-            lst = node[key]
-            item = lst[nxt] if nxt < len(lst) else None
-            entry.append(_label(key, item, nxt))
-            node = item
-            i += 2
-            consumed = i
-            continue
-        break
-    if not entry:
-        return str(rest[0]), ".".join(str(p) for p in rest[1:])
-    return ".".join(entry), ".".join(str(p) for p in rest[consumed:])
-
-
-def _schema_errors(validator, data, file, report):
-    n = 0
-    for err in sorted(validator.iter_errors(data), key=lambda e: [str(p) for p in e.path]):
-        entry, where = _schema_entry(data, list(err.path))
-        report.error(file, entry, f"{where}: {err.message}" if where else err.message)
-        n += 1
-    return n
 
 
 def _int_parameter(spec_dir, area, pid):
@@ -248,7 +204,9 @@ class _Line:
             prev = (entry, (a, b))
 
     # ---- main check
-    def check(self):  # noqa: C901 - one rule after another, in the order of the README
+    def check(self):
+        """The rules of the README, one group after another (a group may skip what an earlier
+        one rejected: one fault, one message); the line JSON object, or None."""
         d = self.d
         f = self.f
         if d["name"] != f.stem:
@@ -263,7 +221,31 @@ class _Line:
         self.L = L
         train_mm = self.mm("design_train", "length_m", d["design_train"]["length_m"])
 
-        # ---- identifiers
+        self._check_identifiers()
+        kmp = self._kilometre_posts()
+        tracks = self._tracks()
+        rlines = self._running_lines(tracks)
+        self._virtual_blocks(tracks)
+        grads, speeds, curves = self._profile()
+        nostop = self._no_stop_sections()
+        balises = self._balises(tracks)
+        lcs = self._level_crossings(L, train_mm, nostop)
+        declared, points = self._points(tracks)
+        self._loops(tracks, declared, points)
+        routes = self._routes(rlines, declared, points)
+        stations = self._stations(tracks, rlines, nostop, train_mm)
+        cells, handovers = self._radio()
+        if not self.ok:
+            return None
+        return self._emit(kmp, rlines, grads, speeds, curves, balises, stations, points,
+                          routes, lcs, cells, handovers, nostop, train_mm)
+
+    # ---- rule groups, in the order of the README
+    def _check_identifiers(self):
+        """Identifiers are unique: balises, points, level crossings, radio cells, handovers,
+        no-stop sections, stations and platforms share one namespace; tracks, running lines and
+        routes each have their own."""
+        d = self.d
         seen = {}
         for section in _LOCATED:
             for i, item in enumerate(d.get(section) or []):
@@ -281,7 +263,10 @@ class _Line:
                 self._unique(own, item["id"], _label(section, item, i),
                              f"entry {i + 1} of {section}")
 
-        # ---- kilometre posts
+    def _kilometre_posts(self):
+        """[(at, km)] in mm: on the line, chainage and kilometrage strictly increasing."""
+        d = self.d
+        L = self.L
         kmp, prev = [], None
         for i, k in enumerate(d["kilometre_posts"]):
             entry = f"kilometre_posts[{i}]"
@@ -297,8 +282,12 @@ class _Line:
                                 f"does not follow km {prev[1] / 1e6:g} at {_m(prev[0])} m")
             kmp.append((at, km))
             prev = (at, km)
+        return kmp
 
-        # ---- tracks (loops need points: read points first)
+    def _tracks(self):
+        """{id: track}: main tracks span the line, a loop lies strictly inside it."""
+        d = self.d
+        L = self.L
         tracks = {}
         for i, t in enumerate(d["tracks"]):
             if t["kind"] == "main" and any(k in t for k in ("from_m", "to_m", "points")):
@@ -316,8 +305,12 @@ class _Line:
                 t["range"] = r
         if not any(t["kind"] == "main" for t in tracks.values()):
             self.err("tracks", "no main track")
+        return tracks
 
-        # ---- running lines
+    def _running_lines(self, tracks):
+        """{id: running line}: on a main track, system boundary strictly inside the line."""
+        d = self.d
+        L = self.L
         rlines = {}
         for i, rl in enumerate(d["running_lines"]):
             entry = _label("running_lines", rl, i)
@@ -337,8 +330,12 @@ class _Line:
             rlines.setdefault(rl["id"], {"entry": entry, "track": rl["track"],
                                          "inc": rl["direction"] == "increasing",
                                          "boundary": boundary, "ok": track_ok})
+        return rlines
 
-        # ---- virtual blocks
+    def _virtual_blocks(self, tracks):
+        """self.blocks: the sorted blocks of each track whose blocks tile it exactly (at
+        most max_blocks)."""
+        d = self.d
         per_track = {}
         for i, vb in enumerate(d["virtual_blocks"]):
             entry = f"virtual_blocks[{i}]"
@@ -374,7 +371,11 @@ class _Line:
                 self.err(t["entry"], f"{len(bl)} virtual blocks exceed max_blocks "
                                      f"{self.max_blocks} (spec/parameters)")
 
-        # ---- gradients, speed limits, curves
+    def _profile(self):
+        """(gradients, speed limits, curves): gradients and limits cover the line, curves lie
+        on it without overlapping."""
+        d = self.d
+        L = self.L
         grads = []
         for i, g in enumerate(d["gradients"]):
             entry = f"gradients[{i}]"
@@ -394,8 +395,12 @@ class _Line:
             if r is not None:
                 curves.append((entry, r, c["radius_m"]))
         self._disjoint([(e, r) for e, r, _ in curves], 0, L, "curves")
+        return grads, speeds, curves
 
-        # ---- no-stop sections
+    def _no_stop_sections(self):
+        """[(entry, (a, b), id)] on the line, in order, not overlapping."""
+        d = self.d
+        L = self.L
         nostop = []
         for i, n in enumerate(d.get("no_stop_sections") or []):
             entry = _label("no_stop_sections", n, i)
@@ -403,8 +408,11 @@ class _Line:
             if r is not None:
                 nostop.append((entry, r, n["id"]))
         self._disjoint([(e, r) for e, r, _ in nostop], 0, L, "no-stop sections")
+        return nostop
 
-        # ---- balises, level crossings
+    def _balises(self, tracks):
+        """[(id, track, at)] strictly inside their track."""
+        d = self.d
         balises = []
         for i, b in enumerate(d["balises"]):
             entry = _label("balises", b, i)
@@ -421,9 +429,12 @@ class _Line:
                                 f"{b['track']} {_sec(lo, hi)} required)")
                 continue
             balises.append((b["id"], b["track"], at))
-        lcs = self._level_crossings(L, train_mm, nostop)
+        return balises
 
-        # ---- points
+    def _points(self, tracks):
+        """(declared, points): each set of points on its track within exactly one virtual block
+        of its own, reverse_to another existing track."""
+        d = self.d
         # Points that fail a rule are reported once here; later rules skip what refers to
         # them (declared), so that one fault gives one message.
         declared = {}
@@ -471,8 +482,10 @@ class _Line:
             block_owner[(p["track"], blk)] = entry
             points.setdefault(p["id"], {"entry": entry, "track": p["track"], "range": r,
                                         "block": blk, "reverse_to": p["reverse_to"]})
+        return declared, points
 
-        # loops connect to their points
+    def _loops(self, tracks, declared, points):
+        """A loop runs between its two points, which lie on one main track and lead to it."""
         for tid, t in tracks.items():
             if t["kind"] != "loop" or t["range"] is None:
                 continue
@@ -503,7 +516,10 @@ class _Line:
                 self.err(t["entry"], f"points {ends[0]} and {ends[1]} lie on different tracks")
             t["parent"] = declared[ends[0]]["track"] if ends[0] in declared else None
 
-        # ---- routes
+    def _routes(self, rlines, declared, points):
+        """[route]: on an existing running line, in its direction, containing its points' block."""
+        d = self.d
+        L = self.L
         routes = []
         for i, ro in enumerate(d.get("routes") or []):
             entry = _label("routes", ro, i)
@@ -539,8 +555,12 @@ class _Line:
             routes.append({"id": ro["id"], "rl": ro["running_line"], "range": (lo, hi),
                            "points": ro["points"], "reverse": ro["position"] == "reverse",
                            "automatic": ro["automatic"]})
+        return routes
 
-        # ---- stations and platforms
+    def _stations(self, tracks, rlines, nostop, train_mm):
+        """[stop]: platforms on their track, long enough, not overlapping; each stop reachable,
+        on its platform, outside no-stop sections, one per station and running line."""
+        d = self.d
         stations = []
         plat_by_track = {}
         for i, st in enumerate(d["stations"]):
@@ -611,8 +631,12 @@ class _Line:
             for (s1, e1), (s2, e2) in zip(stops, stops[1:]):
                 if s1 == s2:
                     self.err(e2, f"stops.{rid}: same stop point {_m(s2)} m as {e1}")
+        return stations
 
-        # ---- radio cells and handovers
+    def _radio(self):
+        """(cells, handovers): cells cover the line, exactly one handover per cell boundary."""
+        d = self.d
+        L = self.L
         cells = []
         for i, c in enumerate(d["radio_cells"]):
             entry = _label("radio_cells", c, i)
@@ -646,11 +670,7 @@ class _Line:
         for b, cell_entry in sorted(boundaries.items()):
             if cells_known and b not in at_boundary:
                 self.err(cell_entry, f"the cell boundary at {_m(b)} m has no handover point")
-
-        if not self.ok:
-            return None
-        return self._emit(kmp, rlines, grads, speeds, curves, balises, stations, points,
-                          routes, lcs, cells, handovers, nostop, train_mm)
+        return cells, handovers
 
     # ---- level crossings (REQ-LC-016)
     def _level_crossings(self, L, train_mm, nostop):
@@ -815,69 +835,17 @@ def check_lines(spec_dir, report):
         return outputs, refs
     for bad in sorted(lines_dir.glob("*.yml")):
         report.error(bad, "-", "use the .yaml extension (files named *.yml are not read)")
-    files = line_files(spec_dir)
-    if not files:
-        return outputs, refs
-    try:
-        validator = vmod._load_schema(spec_dir, SCHEMA_FILE)
-    except SpecError as exc:
-        report.error(exc.file, exc.entry, exc.reason)
-        return outputs, refs
     max_blocks = _max_blocks(spec_dir)
     lc_limits = _CrossingLimits.from_spec(spec_dir)
-    for f in files:
-        try:
-            data = spec_mod.load_yaml(f)
-        except SpecError as exc:
-            report.error(exc.file, exc.entry, exc.reason)
-            continue
-        if _schema_errors(validator, data, f, report):
-            continue
-        name = data["name"]
-        refs.append((f, name, "assumption", data["assumption"]))
-        refs.extend((f, name, f"source[{i}]", s) for i, s in enumerate(data["source"]))
+
+    def check(f, data):
+        refs.extend(vmod.provenance_refs(f, data["name"], data))
         obj = _Line(f, data, report, max_blocks, lc_limits).check()
         if obj is not None:
-            outputs[name] = obj
+            outputs[data["name"]] = obj
+
+    vmod.check_data_files(spec_dir, line_files(spec_dir), SCHEMA_FILE, report, check)
     return outputs, refs
-
-
-def _known_assumptions(spec_dir, report):
-    ids = set()
-    for f in spec_mod.spec_files(spec_dir, "assumptions"):
-        try:
-            data = spec_mod.load_yaml(f)
-        except SpecError as exc:
-            report.error(exc.file, exc.entry, exc.reason)
-            return None
-        for e in data.get("assumptions") or []:
-            if isinstance(e, dict) and isinstance(e.get("id"), str):
-                ids.add(e["id"])
-    return ids
-
-
-def check_refs(refs, known, report):
-    """Every ASM-NNN named by a line file must exist."""
-    for f, entry, where, s in refs:
-        for token in vmod.ID_TOKEN.findall(s):
-            if token.startswith("ASM-") and vmod.ASM_ID.match(token) and token not in known:
-                report.error(f, entry, f"{where}: unknown assumption {token}")
-            elif token.startswith("ASM-") and not vmod.ASM_ID.match(token):
-                report.error(f, entry, f"{where}: malformed reference {token!r}")
-
-
-def render(obj):
-    """Deterministic JSON text of one line (sorted keys, fixed indentation)."""
-    return json.dumps(obj, sort_keys=True, indent=1, ensure_ascii=False) + "\n"
-
-
-def _write(path: Path, text: str):
-    path.parent.mkdir(parents=True, exist_ok=True)
-    if path.exists() and path.read_text(encoding="utf-8") == text:
-        return
-    tmp = path.with_name(path.name + ".tmp")
-    tmp.write_text(text, encoding="utf-8")
-    tmp.replace(path)  # atomic: a reader never sees a half-written file
 
 
 def build(spec_dir):
@@ -890,9 +858,7 @@ def build(spec_dir):
     outputs, refs = check_lines(spec_dir, report)
     if not line_files(spec_dir) and not report.errors:
         report.error(spec_dir / SUB, "-", "no line files (*.yaml)")
-    known = _known_assumptions(spec_dir, report)
-    if known is not None:
-        check_refs(refs, known, report)
+    vmod.check_assumption_refs(spec_dir, refs, report)
     return outputs, report
 
 
@@ -900,25 +866,19 @@ def generate(spec_dir, out_dir):
     """Validate spec/lines and write OUT/<name>.json; raises SpecError (first error, with
     the count of the others) and writes nothing if any line file is invalid."""
     outputs, report = build(spec_dir)
-    if report.errors:
-        first, more = report.errors[0], len(report.errors) - 1
-        raise SpecError(first.file, first.entry,
-                        first.reason + (f" (and {more} more)" if more else ""))
+    vmod.raise_first(report)
     for name, obj in sorted(outputs.items()):
-        _write(Path(out_dir) / f"{name}.json", render(obj))
+        spec_mod.write_atomic(Path(out_dir) / f"{name}.json", spec_mod.render_json(obj))
     return sorted(outputs)
 
 
 def run(args):
     spec_dir, out_dir = Path(args.spec), Path(args.out)
     outputs, report = build(spec_dir)
-    report.print()
-    if report.errors:
-        print(f"lines: {len(report.errors)} error(s) in {spec_dir / SUB}; nothing written",
-              file=sys.stderr)
+    if vmod.failed(report, "lines", spec_dir / SUB):
         return 1
     for name, obj in sorted(outputs.items()):
-        _write(out_dir / f"{name}.json", render(obj))
+        spec_mod.write_atomic(out_dir / f"{name}.json", spec_mod.render_json(obj))
         rls = obj["running_lines"]
         print(f"lines: {name}: {len(rls)} running line(s) "
               f"({', '.join(r['id'] for r in rls)}), {_m(rls[0]['length_mm'])} m, "

@@ -125,7 +125,10 @@ def load(spec_dir: Path) -> Registry:
     spec_dir = Path(spec_dir)
     path = spec_dir / REGISTRY
     data = load_yaml(path)
-    schema = json.loads((spec_dir / SCHEMA).read_text(encoding="utf-8"))
+    try:
+        schema = json.loads((spec_dir / SCHEMA).read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise SpecError(spec_dir / SCHEMA, "-", "file not found") from None
     errors = sorted(jsonschema.Draft202012Validator(schema).iter_errors(data), key=lambda e: list(e.path))
     if errors:
         e = errors[0]

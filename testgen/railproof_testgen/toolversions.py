@@ -1,4 +1,5 @@
-"""Record the versions of every tool that produced evidence (for the evidence package)."""
+"""Record the versions of every tool that produced evidence (results/tool-versions.json, shown
+in the evidence package, which also names the versions of DOC_PACKAGES it was rendered with)."""
 from __future__ import annotations
 
 import json
@@ -11,7 +12,21 @@ from pathlib import Path
 DEBIAN_PACKAGES = ["spin", "cmake", "ninja-build", "g++", "clang", "libgtest-dev", "libbenchmark-dev",
                    "libsodium-dev", "coinor-libipopt-dev", "libompl-dev", "libbox2d-dev", "nlohmann-json3-dev",
                    "gcovr"]
-PYTHON_PACKAGES = ["Sphinx", "sphinx-needs", "sphinx-test-reports", "PyYAML", "jsonschema", "pytest"]
+# the documentation tool chain that renders the evidence package
+DOC_PACKAGES = ["Sphinx", "sphinx-needs", "sphinx-test-reports", "docutils", "Jinja2", "PyYAML"]
+# and the Python tools whose results it shows (schemas, tests, the two SMT solvers)
+PYTHON_PACKAGES = DOC_PACKAGES + ["jsonschema", "pytest", "z3-solver", "cvc5"]
+
+
+def package_versions(names) -> dict:
+    """{distribution: installed version or "not installed"} of the current Python."""
+    out = {}
+    for name in names:
+        try:
+            out[name] = metadata.version(name)
+        except metadata.PackageNotFoundError:
+            out[name] = "not installed"
+    return out
 
 
 def _cmd(args):
@@ -27,13 +42,8 @@ def collect(compiler: str | None = None) -> dict:
     for pkg in DEBIAN_PACKAGES:
         v = _cmd(["dpkg-query", "-W", "-f=${Version}", pkg])
         deb[pkg] = v if v and not v.startswith("dpkg-query") else "not installed"
-    py = {}
-    for pkg in PYTHON_PACKAGES:
-        try:
-            py[pkg] = metadata.version(pkg)
-        except metadata.PackageNotFoundError:
-            py[pkg] = "not installed"
-    out = {"debian_packages": deb, "python": platform.python_version(), "python_packages": py,
+    out = {"debian_packages": deb, "python": platform.python_version(),
+           "python_packages": package_versions(PYTHON_PACKAGES),
            "spin": _cmd(["spin", "-V"])}
     if compiler:
         out["compiler"] = _cmd([compiler, "--version"])

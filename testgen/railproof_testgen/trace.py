@@ -11,8 +11,12 @@ Link sources (paths relative to REPO_ROOT unless noted):
 - ``RESULTS_DIR/vectors/*.jsonl`` (header line, then vectors with ``id`` and
   ``requirements``) and ``*.coverage.json`` (goal coverage; an ``unreachable`` goal needs a
   justification from ``spec/justifications/*.yaml`` written for that goal and model);
-- C++ tags ``@implements REQ-…`` (code units: ``cpp/src``, ``cpp/include``, ``cpp/tools``)
-  and ``@verifies REQ-…`` (tests: ``cpp/tests``, with the ``TEST(...)`` that follows);
+- C++ tags ``@implements REQ-…`` and ``@verifies REQ-…``. An ``@implements`` under
+  ``cpp/runtime/<module>/{include,src}`` is a runtime code unit (link ``code``); one under
+  ``cpp/offline/<module>/{include,src,tools}`` is an offline tool unit (link ``tool``), which
+  never counts as the implementation of a runtime requirement. An ``@verifies`` in a test
+  (a ``tests/``, ``conformance/`` or ``fuzz/`` folder, with the ``TEST(...)`` that follows)
+  is a test link (``unit``);
 - ``proofs/**`` tags ``@verifies REQ-…`` and ``@obligation <name> REQ-… : text``;
 - ``RESULTS_DIR/analysis/*.json`` with a top-level ``"requirements": [...]`` list.
 
@@ -20,8 +24,10 @@ Errors (exit 1): a dangling or malformed reference anywhere; a property ``violat
 ``incomplete``; a mutant that survived; an unreachable goal without a matching
 justification; an empty vector set; a requirement whose verification method X has no link
 of kind X (model: a verified property; vectors: a vector; unit: a ``@verifies`` test;
-analysis: an analysis result; proof: an obligation); a SIL-4 requirement without an
-``@implements`` code unit unless it is verified by analysis alone.  With
+analysis: an analysis result; proof: an obligation); a SIL-4 runtime requirement (the
+default ``implemented_by: runtime``) without an ``@implements`` unit under ``cpp/runtime``
+unless it is verified by analysis alone; a requirement ``implemented_by: offline`` without
+an ``@implements`` unit under ``cpp/offline``.  With
 ``--allow-missing-results`` a missing results directory (and the links only it could
 supply) is a warning, so the check can run before the pipeline has produced results.
 Stale results (a property, mutant or goal in the results that no annotation names) are
@@ -33,9 +39,11 @@ RESULTS_DIR, no time stamps)::
 
     {"schema": "railproof/trace/1",
      "requirements": [{"id", "area", "title", "sil", "source", "hazards", "verification",
-                       "links": {"model": [{"property", "verdict", "model"}],
+                       "implemented_by": "runtime" | "offline",
+                     "links": {"model": [{"property", "verdict", "model"}],
                                  "goals": ["G17", ...], "vectors": ["TG-TRAP-017", ...],
                                  "unit": [{"file", "test"}], "code": [{"file", "unit"}],
+                                 "tool": [{"file", "unit"}],
                                  "analysis": ["analysis/residual_error.json"],
                                  "proof": [{"file", "obligation"}]},
                        "status": "ok" | "error", "problems": ["file: entry: reason"]}],
@@ -55,7 +63,7 @@ from .errors import SpecError
 from .validate import REQ_ID, Report, check_spec
 
 SCHEMA = "railproof/trace/1"
-LINK_KINDS = ("model", "goals", "vectors", "unit", "code", "analysis", "proof")
+LINK_KINDS = ("model", "goals", "vectors", "unit", "code", "tool", "analysis", "proof")
 # verification method -> the link kind that satisfies it
 METHOD_LINK = {"model": "model", "vectors": "vectors", "unit": "unit",
                "analysis": "analysis", "proof": "proof"}
@@ -63,8 +71,9 @@ METHOD_LINK = {"model": "model", "vectors": "vectors", "unit": "unit",
 RESULT_KINDS = {"model": "spin", "vectors": "vectors", "analysis": "analysis"}
 
 CPP_SUFFIXES = {".cpp", ".cc", ".cxx", ".hpp", ".hh", ".hxx", ".h", ".ipp", ".inl"}
-CODE_DIRS = ("cpp/src", "cpp/include", "cpp/tools")
-TEST_DIRS = ("cpp/tests",)
+# cpp/<kind>/<module>/<part>/...: runtime code, offline tools, tests (by the folder names)
+_CODE_PATH = re.compile(r"^cpp/(runtime|offline)/[^/]+/(include|src|tools)/")
+_TEST_PATH = re.compile(r"^cpp/.*/(tests|conformance|fuzz)/")
 FAILED_VERDICTS = {"fail", "failed", "violated", "error"}
 
 # Tags open a comment: prose that merely mentions "@implements" is not a tag, and the
@@ -557,8 +566,9 @@ class Tracer:
             return
         for f in sorted(p for p in root.rglob("*") if p.suffix in CPP_SUFFIXES and p.is_file()):
             rel = self.rel(f)
-            is_test = any(rel.startswith(d + "/") for d in TEST_DIRS)
-            is_code = any(rel.startswith(d + "/") for d in CODE_DIRS)
+            is_test = bool(_TEST_PATH.match(rel))
+            code = _CODE_PATH.match(rel)
+            link = None if code is None else ("code" if code.group(1) == "runtime" else "tool")
             lines = self.read_lines(f)
             if lines is None:
                 continue
@@ -574,7 +584,8 @@ class Tracer:
                     continue
                 if tag == "verifies":
                     if not is_test:
-                        self.warn(f, entry, "@verifies outside cpp/tests is not a test link")
+                        self.warn(f, entry, "@verifies outside a tests, conformance or fuzz folder "
+                                            "is not a test link")
                         continue
                     test = self._test_after(lines, n)
                     if test is None and any("LLVMFuzzerTestOneInput" in ln
@@ -591,13 +602,14 @@ class Tracer:
                         self.add(r, "unit", {"file": rel, "test": test})
                     self.test_set.add((rel, test))
                 else:
-                    if not is_code:
-                        self.warn(f, entry, "@implements outside cpp/src, cpp/include, "
-                                            "cpp/tools is not a code link")
+                    if link is None:
+                        self.warn(f, entry, "@implements outside cpp/runtime/<module>/{include,src} "
+                                            "and cpp/offline/<module>/{include,src,tools} is not "
+                                            "a code link")
                         continue
                     unit = self._unit_after(line, lines, n) or f"(line {n})"
                     for r in ids:
-                        self.add(r, "code", {"file": rel, "unit": unit})
+                        self.add(r, link, {"file": rel, "unit": unit})
                     self.unit_set.add((rel, unit))
 
     @staticmethod
@@ -850,9 +862,15 @@ class Tracer:
                                 "proof": "no proof obligation names it"}[kind]
                         self.error(self.rel_spec(f), rid, f"verification '{method}': {what}",
                                    [rid])
-            if r.get("sil") == 4 and set(ver) != {"analysis"} and not L["code"]:
-                self.error(self.rel_spec(f), rid, "SIL-4 requirement has no @implements code "
-                           "unit in cpp/src, cpp/include or cpp/tools", [rid])
+            if r.get("implemented_by", "runtime") == "offline":
+                if not L["tool"]:
+                    self.error(self.rel_spec(f), rid, "implemented_by offline: no @implements unit "
+                               "under cpp/offline names it", [rid])
+            elif r.get("sil") == 4 and set(ver) != {"analysis"} and not L["code"]:
+                extra = (f" (offline code never implements a runtime requirement: "
+                         f"{', '.join(sorted({u['file'] for u in L['tool']}))})" if L["tool"] else "")
+                self.error(self.rel_spec(f), rid, "SIL-4 runtime requirement has no @implements "
+                           "unit under cpp/runtime" + extra, [rid])
 
     def rel_spec(self, f):
         return self.rel(Path(f))
@@ -907,7 +925,8 @@ class Tracer:
             reqs.append({
                 "id": rid, "area": r["area"], "title": r.get("title"), "sil": r.get("sil"),
                 "source": list(r.get("source") or []), "hazards": sorted(r.get("hazards") or []),
-                "verification": list(r.get("verification") or []), "links": links,
+                "verification": list(r.get("verification") or []),
+                "implemented_by": r.get("implemented_by", "runtime"), "links": links,
                 "status": "error" if problems else "ok", "problems": problems})
         props = [res["verdict"] for p in self.properties.values() for res in p["results"]]
         prop_missing = sum(1 for p in self.properties.values() if not p["results"])

@@ -20,10 +20,8 @@ Rules after the schema:
 """
 from __future__ import annotations
 
-import sys
 from pathlib import Path
 
-from . import lines as lines_mod
 from . import spec as spec_mod
 from . import validate as vmod
 from .errors import SpecError
@@ -59,11 +57,8 @@ def _check(f, data, report, mutant):
     if name != f.stem:
         report.error(f, name, f"name {name!r} must equal the file name {f.stem!r}")
         ok = False
-    for i, s in enumerate(data["source"]):
-        if not vmod.CITATION.search(s):
-            report.error(f, name, f"source[{i}] {s!r} cites no D1-D5 section, ASM-NNN or "
-                                  "named standard")
-            ok = False
+    if not vmod.check_sources(report, f, name, data["source"]):
+        ok = False
     for group, key in _RANGES:
         lo, hi = data[group][key]
         if lo > hi:
@@ -91,28 +86,16 @@ def check_trains(spec_dir, report, with_mutants=False):
     root = spec_dir / SUB
     if not root.is_dir():
         return outputs, refs
-    try:
-        validator = vmod._load_schema(spec_dir, SCHEMA_FILE)
-    except SpecError as exc:
-        report.error(exc.file, exc.entry, exc.reason)
-        return outputs, refs
-    groups = [(False, sorted(root.glob("*.yaml")))]
-    if with_mutants:
-        groups.append((True, sorted((root / MUTANTS).glob("*.yaml"))))
-    for mutant, files in groups:
-        for f in files:
-            try:
-                data = spec_mod.load_yaml(f)
-            except SpecError as exc:
-                report.error(exc.file, exc.entry, exc.reason)
-                continue
-            if lines_mod._schema_errors(validator, data, f, report):
-                continue
-            refs.append((f, data["name"], "assumption", data["assumption"]))
-            refs.extend((f, data["name"], f"source[{i}]", s) for i, s in enumerate(data["source"]))
+    for mutant, files in [(False, sorted(root.glob("*.yaml")))] + \
+            ([(True, sorted((root / MUTANTS).glob("*.yaml")))] if with_mutants else []):
+
+        def check(f, data, mutant=mutant):
+            refs.extend(vmod.provenance_refs(f, data["name"], data))
             obj = _check(f, data, report, mutant)
             if obj is not None:
                 outputs[(mutant, data["name"])] = obj
+
+        vmod.check_data_files(spec_dir, files, SCHEMA_FILE, report, check)
     return outputs, refs
 
 
@@ -125,23 +108,18 @@ def build(spec_dir):
     outputs, refs = check_trains(spec_dir, report, with_mutants=True)
     if not any(not m for m, _ in outputs) and not report.errors:
         report.error(spec_dir / SUB, "-", "no train type files (*.yaml)")
-    known = lines_mod._known_assumptions(spec_dir, report)
-    if known is not None:
-        lines_mod.check_refs(refs, known, report)
+    vmod.check_assumption_refs(spec_dir, refs, report)
     return outputs, report
 
 
 def run(args):
     spec_dir, out_dir = Path(args.spec), Path(args.out)
     outputs, report = build(spec_dir)
-    report.print()
-    if report.errors:
-        print(f"trains: {len(report.errors)} error(s) in {spec_dir / SUB}; nothing written",
-              file=sys.stderr)
+    if vmod.failed(report, "trains", spec_dir / SUB):
         return 1
     for (mutant, name), obj in sorted(outputs.items()):
         path = out_dir / (MUTANTS if mutant else "") / f"{name}.json"
-        lines_mod._write(path, lines_mod.render(obj))
+        spec_mod.write_atomic(path, spec_mod.render_json(obj))
         print(f"trains: {'negative-test ' if mutant else ''}{name} -> {path}")
     return 0
 

@@ -3,10 +3,13 @@
 Command ``validate --spec DIR`` checks every YAML file of
 ``spec/{requirements,hazards,assumptions,parameters,justifications}`` against the
 Draft 2020-12 schemas in ``spec/schemas/``, then the cross-references the schemas cannot
-express. It also checks the line data ``spec/lines/*.yaml`` (if that directory exists)
-with the schema and topology rules of ``lines.py``; a line's assumption must exist. It
-collects every finding, prints each as one line ``file: entry: reason`` and exits 1 if
-there is any error (warnings alone do not fail).
+express. It also checks the data files, each against its schema and then what the schema
+cannot say (what a file names in the others): the lines (``lines.py``), the train types
+(``trains.py``), the timetables (``timetables.py``), the line scenarios
+``spec/scenarios/*.json`` and the wheel-rail scenarios ``spec/wheelrail/*.json`` (below);
+the assumptions and requirements they name must exist. It collects every finding, prints
+each as one line ``file: entry: reason`` and exits 1 if there is any error (warnings alone
+do not fail).
 
 Rules checked after the schema:
 - IDs are unique within and across files (requirements, hazards, assumptions,
@@ -150,13 +153,253 @@ def _entry_name(data, path):
     return str(head), ".".join(str(p) for p in path[1:])
 
 
-def _schema_errors(validator, data, file, report):
+def _schema_errors(validator, data, file, report, entry_of=_entry_name):
+    """Report every schema error as ``file: entry: where: message`` (the entry named by
+    entry_of(data, path)); returns their number."""
     n = 0
     for err in sorted(validator.iter_errors(data), key=lambda e: [str(p) for p in e.path]):
-        entry, where = _entry_name(data, list(err.path))
+        entry, where = entry_of(data, list(err.path))
         report.error(file, entry, f"{where}: {err.message}" if where else err.message)
         n += 1
     return n
+
+
+def label(section, item, index):
+    """Entry name of item `index` of list `section`: ``section[<id or name>]``, else the index."""
+    if isinstance(item, dict):
+        for key in ("id", "name"):
+            v = item.get(key)
+            if isinstance(v, (str, int)) and not isinstance(v, bool) and v != "":
+                return f"{section}[{v}]"
+    return f"{section}[{index}]"
+
+
+def _schema_entry(data, path):
+    """(entry, where) for a schema error at `path` inside `data` (data files: lists of
+    entries are named by label(), nested lists too, e.g. ``stations[S1].platforms[P2]``)."""
+    if not path:
+        return "-", ""
+    entry, node, rest = [], data, list(path)
+    consumed = 0
+    i = 0
+    while i < len(rest):
+        key = rest[i]
+        nxt = rest[i + 1] if i + 1 < len(rest) else None
+        if isinstance(key, str) and isinstance(nxt, int) and isinstance(node, dict) \
+                and isinstance(node.get(key), list):
+            lst = node[key]
+            item = lst[nxt] if nxt < len(lst) else None
+            entry.append(label(key, item, nxt))
+            node = item
+            i += 2
+            consumed = i
+            continue
+        break
+    if not entry:
+        return str(rest[0]), ".".join(str(p) for p in rest[1:])
+    return ".".join(entry), ".".join(str(p) for p in rest[consumed:])
+
+
+def data_schema_errors(validator, data, file, report):
+    """The schema errors of a data file (lines, trains, timetables, scenarios), entries
+    named by label()."""
+    return _schema_errors(validator, data, file, report, _schema_entry)
+
+
+def check_data_files(spec_dir, files, schema_name, report, check, load=spec_mod.load_yaml):
+    """The one loop over the data files of spec/: load each file, check it against
+    spec/schemas/<schema_name>, and call check(file, data) for every schema-valid file.
+    Nothing stops at the first finding."""
+    if not files:
+        return
+    try:
+        validator = _load_schema(spec_dir, schema_name)
+    except SpecError as exc:
+        report.error(exc.file, exc.entry, exc.reason)
+        return
+    for f in files:
+        try:
+            data = load(f)
+        except SpecError as exc:
+            report.error(exc.file, exc.entry, exc.reason)
+            continue
+        if data_schema_errors(validator, data, f, report):
+            continue
+        check(f, data)
+
+
+def check_sources(report, file, entry, sources):
+    """Every source string cites D1-D5 with a section, an ASM-NNN or a named standard;
+    returns False if one does not."""
+    ok = True
+    for i, s in enumerate(sources):
+        if isinstance(s, str) and not CITATION.search(s):
+            report.error(file, entry, f"source[{i}] {s!r} cites no D1-D5 section, ASM-NNN or "
+                                      "named standard")
+            ok = False
+    return ok
+
+
+def provenance_refs(file, name, data):
+    """(file, entry, field, text) of a data file's assumption and sources, for the check
+    that the assumptions they name exist."""
+    refs = [(file, name, "assumption", data["assumption"])] if "assumption" in data else []
+    refs.extend((file, name, f"source[{i}]", s) for i, s in enumerate(data.get("source") or []))
+    return refs
+
+
+def known_assumptions(spec_dir, report):
+    """Ids of spec/assumptions, or None if a file cannot be read (reported)."""
+    ids = set()
+    for f in spec_mod.spec_files(spec_dir, "assumptions"):
+        try:
+            data = spec_mod.load_yaml(f)
+        except SpecError as exc:
+            report.error(exc.file, exc.entry, exc.reason)
+            return None
+        for e in data.get("assumptions") or []:
+            if isinstance(e, dict) and isinstance(e.get("id"), str):
+                ids.add(e["id"])
+    return ids
+
+
+def check_assumption_refs(spec_dir, refs, report):
+    """Every ASM-NNN named by a data file must exist in spec/assumptions (used by the
+    single-kind commands lines, trains and timetables; validate checks every kind of
+    reference)."""
+    known = known_assumptions(spec_dir, report)
+    if known is None:
+        return
+    for f, entry, where, s in refs:
+        for token in ID_TOKEN.findall(s):
+            if token.startswith("ASM-") and ASM_ID.match(token) and token not in known:
+                report.error(f, entry, f"{where}: unknown assumption {token}")
+            elif token.startswith("ASM-") and not ASM_ID.match(token):
+                report.error(f, entry, f"{where}: malformed reference {token!r}")
+
+
+def missing_data(spec_dir, sub, name, what):
+    """Reason for a name that no valid file of spec/<sub> defines."""
+    path = Path(spec_dir) / sub / f"{name}.yaml"
+    if path.exists():
+        return f"{what} {name!r} has errors ({sub}/{path.name}, reported by validate)"
+    return f"unknown {what} {name!r} (no {sub}/{path.name})"
+
+
+def failed(report, command, where):
+    """Print the findings of a converting command; True (after a summary line) if there is
+    an error, and then the command writes nothing."""
+    report.print()
+    if report.errors:
+        print(f"{command}: {len(report.errors)} error(s) in {where}; nothing written",
+              file=sys.stderr)
+        return True
+    return False
+
+
+def raise_first(report):
+    """Raise the report's first error as SpecError, with the count of the others."""
+    if report.errors:
+        first, more = report.errors[0], len(report.errors) - 1
+        raise SpecError(first.file, first.entry,
+                        first.reason + (f" (and {more} more)" if more else ""))
+
+
+def _check_file_name(report, f, data):
+    if data["name"] != f.stem:
+        report.error(f, "name", f"{data['name']!r} must equal the file name {f.stem!r}")
+
+
+def check_scenarios(spec_dir, report, lines, files=None):
+    """spec/scenarios/*.json (line_sim), or the given files: the schema, then what it
+    cannot say: the name is the file name (of spec/scenarios), the line is a valid line of spec/lines with the running line, every stop
+    names a station of that running line, and a siding request names a route of it (none
+    named: the running line has a reverse, non-automatic route). The rules within the file
+    (ordering, windows, train ids) are the simulator's (spec/design/data.md)."""
+    out, own = {}, files is None
+
+    def check(f, data):
+        if own:
+            _check_file_name(report, f, data)
+        line = lines.get(data["line"])
+        if line is None:
+            report.error(f, "line", missing_data(spec_dir, "lines", data["line"], "line"))
+            return
+        rl = next((r for r in line["running_lines"] if r["id"] == data["running_line"]), None)
+        if rl is None:
+            report.error(f, "running_line", f"unknown running line {data['running_line']!r} on "
+                         f"line {line['name']} (has: "
+                         + ", ".join(r["id"] for r in line["running_lines"]) + ")")
+            return
+        names = [s["name"] for s in rl["stations"]]
+        for i, t in enumerate(data["trains"]):
+            for k, stop in enumerate(t.get("stops") or []):
+                if stop["station"] not in names:
+                    report.error(f, f"{label('trains', t, i)}.stops[{k}]",
+                                 f"station: unknown station {stop['station']!r} on running line "
+                                 f"{rl['id']} (has: {', '.join(names)})")
+        for i, fault in enumerate(data.get("faults") or []):
+            if fault["type"] != "siding_request":
+                continue
+            if "route" in fault and not any(r["id"] == fault["route"] for r in rl["routes"]):
+                report.error(f, f"faults[{i}]", f"route: unknown route {fault['route']} on running "
+                                                f"line {rl['id']}")
+            elif "route" not in fault and not any(r["reverse"] and not r["automatic"]
+                                                  for r in rl["routes"]):
+                report.error(f, f"faults[{i}]", f"running line {rl['id']} has no siding "
+                                                "(reverse, non-automatic) route")
+        out[data["name"]] = data
+
+    if own:
+        files = sorted((Path(spec_dir) / "scenarios").glob("*.json"))
+    check_data_files(spec_dir, files, "scenario.schema.json", report, check,
+                     load=spec_mod.load_json)
+    return out
+
+
+def check_wheelrail(spec_dir, report, files=None):
+    """spec/wheelrail/*.json (wheelrail_sim, odometry_study), or the given files: the
+    schema, then what it cannot say: the name is the file name (of spec/wheelrail) and
+    every requirement named exists (returned as
+    references for the caller's check). The rules within the file (ordering, the vertical
+    curves fitting, the car inside the alignment) are the simulator's."""
+    out, refs, own = {}, [], files is None
+
+    def check(f, data):
+        if own:
+            _check_file_name(report, f, data)
+        refs.extend((f, data["name"], f"requirements[{i}]", r)
+                    for i, r in enumerate(data["requirements"]))
+        out[data["name"]] = data
+
+    if own:
+        files = sorted((Path(spec_dir) / "wheelrail").glob("*.json"))
+    check_data_files(spec_dir, files, "wheelrail_scenario.schema.json", report, check,
+                     load=spec_mod.load_json)
+    return out, refs
+
+
+# The hand-written data files that `validate --data FILE` checks, by the schema they name.
+_DATA_CHECKS = {"railproof/scenario/1": "scenarios", "railproof/wheelrail-scenario/1": "wheelrail"}
+
+
+def _check_data_args(spec_dir, paths, model, refs, report):
+    """Files given on the command line (a scenario written by hand for line_sim or
+    wheelrail_sim): the same checks as the spec's own, but for the file name."""
+    for path in map(Path, paths):
+        try:
+            kind = _DATA_CHECKS.get(spec_mod.load_json(path).get("schema"))
+        except SpecError as exc:
+            report.error(exc.file, exc.entry, exc.reason)
+            continue
+        if kind is None:
+            report.error(path, "schema", "not one of " + ", ".join(sorted(_DATA_CHECKS)))
+        elif kind == "scenarios":
+            model[kind].update(check_scenarios(spec_dir, report, model["lines"], [path]))
+        else:
+            out, more = check_wheelrail(spec_dir, report, [path])
+            model[kind].update(out)
+            refs.extend(more)
 
 
 def _strings(obj, where=""):
@@ -182,9 +425,10 @@ def _list_files(spec_dir: Path, sub: str, report: Report):
     return spec_mod.spec_files(spec_dir, sub)
 
 
-def check_spec(spec_dir):
-    """Check spec_dir completely. Returns (model, report); model is built from the
-    entries that could be read even when the report has errors."""
+def check_spec(spec_dir, data_files=()):
+    """Check spec_dir completely, and the data files `data_files` (paths) against it. Returns
+    (model, report); model is built from the entries that could be read even when the
+    report has errors."""
     spec_dir = Path(spec_dir)
     report = Report()
     if not spec_dir.is_dir():
@@ -250,6 +494,16 @@ def check_spec(spec_dir):
     train_outputs, train_refs = trains_mod.check_trains(spec_dir, report)
     model["trains"] = {name: obj for (_m, name), obj in train_outputs.items()}
     refs.extend(train_refs)
+    # Timetables (spec/timetables, REQ-LC-017) against those lines and train types; the
+    # hand-written JSON data of the simulators (spec/scenarios, spec/wheelrail).
+    from . import timetables as timetables_mod
+    model["timetables"], tt_refs = timetables_mod.check_timetables(
+        spec_dir, report, model["lines"], model["trains"])
+    refs.extend(tt_refs)
+    model["scenarios"] = check_scenarios(spec_dir, report, model["lines"])
+    model["wheelrail"], wr_refs = check_wheelrail(spec_dir, report)
+    refs.extend(wr_refs)
+    _check_data_args(spec_dir, data_files, model, refs, report)
 
     _check_references(model, refs, report)
     _check_requirements(model, report)
@@ -260,7 +514,8 @@ def check_spec(spec_dir):
 
 def _empty_model():
     return {"requirements": {}, "hazards": {}, "assumptions": {}, "justifications": {},
-            "parameters": {}, "lines": {}, "trains": {}}
+            "parameters": {}, "lines": {}, "trains": {}, "timetables": {}, "scenarios": {},
+            "wheelrail": {}}
 
 
 def _collect_parameters(f, data, model, param_areas, refs, report):
@@ -320,12 +575,8 @@ def _check_requirements(model, report):
                 and isinstance(ver, list) and set(ver) == {"review"}:
             report.error(f, rid, f"SIL {sil} requirement verified by review alone; "
                                  "add model, vectors, unit, analysis or proof")
-        src = r.get("source")
-        if isinstance(src, list):
-            for i, s in enumerate(src):
-                if isinstance(s, str) and not CITATION.search(s):
-                    report.error(f, rid, f"source[{i}] {s!r} cites no D1-D5 section, "
-                                         "ASM-NNN or named standard")
+        if isinstance(r.get("source"), list):
+            check_sources(report, f, rid, r["source"])
         if isinstance(sil, int) and sil >= 3 and r.get("hazards") == []:
             report.warn(f, rid, f"SIL {sil} requirement names no hazard")
 
@@ -361,16 +612,12 @@ def validate_spec(spec_dir):
     Raises SpecError naming the first error, with "(and N more)" if there are more.
     """
     model, report = check_spec(spec_dir)
-    if report.errors:
-        first = report.errors[0]
-        more = len(report.errors) - 1
-        raise SpecError(first.file, first.entry,
-                        first.reason + (f" (and {more} more)" if more else ""))
+    raise_first(report)
     return model
 
 
 def run(args):
-    model, report = check_spec(Path(args.spec))
+    model, report = check_spec(Path(args.spec), args.data)
     report.print()
     n = {k: len(v) for k, v in model.items()}
     if report.errors:
@@ -380,7 +627,8 @@ def run(args):
     print(f"validate: {args.spec} ok: {n['requirements']} requirements, {n['hazards']} hazards, "
           f"{n['assumptions']} assumptions, {n['parameters']} parameter file(s), "
           f"{n['justifications']} justifications, {n['lines']} line(s), "
-          f"{n['trains']} train type(s); "
+          f"{n['trains']} train type(s), {n['timetables']} timetable(s), "
+          f"{n['scenarios']} scenario(s), {n['wheelrail']} wheel-rail scenario(s); "
           f"{len(report.warnings)} warning(s)")
     return 0
 
@@ -388,9 +636,15 @@ def run(args):
 def register(sub):
     p = sub.add_parser(
         "validate", help="check spec/ against its JSON schemas and cross-references",
-        description="Validate every YAML file of spec/{requirements,hazards,assumptions,"
-                    "parameters,justifications,lines} against spec/schemas and check IDs, "
-                    "references and the line topology rules. Prints every finding as "
-                    "'file: entry: reason'; exit 1 on any error.")
+        description="Validate every file of spec/{requirements,hazards,assumptions,"
+                    "parameters,justifications,lines,trains,timetables} (YAML) and "
+                    "spec/{scenarios,wheelrail} (JSON) against spec/schemas and check IDs, "
+                    "references, the line topology rules and what each data file names in "
+                    "the others. Prints every finding as 'file: entry: reason'; exit 1 on "
+                    "any error.")
     p.add_argument("--spec", required=True, help="spec/ directory")
+    p.add_argument("--data", action="append", default=[], metavar="FILE",
+                   help="also check this scenario or wheel-rail scenario JSON (for example "
+                        "one written by hand for line_sim or wheelrail_sim) against the "
+                        "spec; repeatable")
     p.set_defaults(func=run)

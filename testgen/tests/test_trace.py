@@ -51,9 +51,9 @@ def test_valid_tree_passes_with_all_links(tree, trace):
                                       "verdict": "verified"}]
     assert tg1["links"]["goals"] == ["G1", "G2"]
     assert tg1["links"]["vectors"] == ["TG-RW-001", "TG-TRAP-001"]
-    assert tg1["links"]["unit"] == [{"file": "cpp/tests/unit/demo/demo_test.cpp",
+    assert tg1["links"]["unit"] == [{"file": "cpp/runtime/demo/tests/demo_test.cpp",
                                      "test": "Sequence.RejectsRepetition"}]
-    assert tg1["links"]["code"] == [{"file": "cpp/src/demo/demo.cpp",
+    assert tg1["links"]["code"] == [{"file": "cpp/runtime/demo/src/demo.cpp",
                                      "unit": "CheckSequenceNumber"}]
     tg2 = _req(r, "REQ-TG-002")
     assert tg2["links"]["analysis"] == ["analysis/residual_error.json"]
@@ -61,9 +61,9 @@ def test_valid_tree_passes_with_all_links(tree, trace):
     mb1 = _req(r, "REQ-MB-001")
     assert mb1["links"]["proof"] == [{"file": "proofs/mb/stop_limit.smt2",
                                       "obligation": "stop_limit_behind_rear"}]
-    assert mb1["links"]["code"] == [{"file": "cpp/include/railproof/demo/demo.hpp",
+    assert mb1["links"]["code"] == [{"file": "cpp/runtime/demo/include/railproof/demo/demo.hpp",
                                      "unit": "StopLimit"}]
-    assert mb1["links"]["unit"] == [{"file": "cpp/tests/unit/demo/demo_test.cpp",
+    assert mb1["links"]["unit"] == [{"file": "cpp/runtime/demo/tests/demo_test.cpp",
                                      "test": "Crc.KnownValue"}]
     # SIL 4 verified by analysis alone needs no code unit
     assert _req(r, "REQ-TG-004")["links"]["code"] == []
@@ -91,10 +91,10 @@ def test_output_is_deterministic_and_location_independent(tree, trace, tmp_path)
 
 
 @pytest.mark.parametrize("case, file, entry, fragment, rid", [
-    ("dangling_verifies", "cpp/tests/unit/demo/extra_test.cpp", "@verifies (line 3)",
+    ("dangling_verifies", "cpp/runtime/demo/tests/extra_test.cpp", "@verifies (line 3)",
      "dangling reference: unknown requirement REQ-TG-099", None),
     ("sil4_no_code", "spec/requirements/tg.yaml", "REQ-TG-001",
-     "SIL-4 requirement has no @implements code unit", "REQ-TG-001"),
+     "SIL-4 runtime requirement has no @implements unit under cpp/runtime", "REQ-TG-001"),
     ("sil4_unverified", "spec/requirements/tg.yaml", "REQ-TG-001",
      "verification 'unit': no @verifies test", "REQ-TG-001"),
     ("violated_property", "spin/demo.json", "property REQ_TG_001_repetition",
@@ -174,13 +174,13 @@ def test_empty_vectors_leave_coverage_dangling(tree, trace):
     ("results/vectors/demo.coverage.json", '"reached": 1', '"reached": 2',
      "vectors/demo.coverage.json", "reached", "says 2 but 1 goals are reached"),
     # C++ and proofs
-    ("cpp/src/demo/demo.cpp", "// @implements REQ-TG-002", "// @implements REQ-TG-2",
-     "cpp/src/demo/demo.cpp", "@implements (line 10)", "malformed requirement id 'REQ-TG-2'"),
-    ("cpp/include/railproof/demo/demo.hpp", "// @implements REQ-MB-001",
-     "// @implements REQ-BR-001", "cpp/include/railproof/demo/demo.hpp",
+    ("cpp/runtime/demo/src/demo.cpp", "// @implements REQ-TG-002", "// @implements REQ-TG-2",
+     "cpp/runtime/demo/src/demo.cpp", "@implements (line 10)", "malformed requirement id 'REQ-TG-2'"),
+    ("cpp/runtime/demo/include/railproof/demo/demo.hpp", "// @implements REQ-MB-001",
+     "// @implements REQ-BR-001", "cpp/runtime/demo/include/railproof/demo/demo.hpp",
      "@implements (line 4)", "unknown requirement REQ-BR-001"),
-    ("cpp/src/demo/demo.cpp", "// @implements REQ-TG-001", "// @implements",
-     "cpp/src/demo/demo.cpp", "@implements (line 5)", "tag names no requirement"),
+    ("cpp/runtime/demo/src/demo.cpp", "// @implements REQ-TG-001", "// @implements",
+     "cpp/runtime/demo/src/demo.cpp", "@implements (line 5)", "tag names no requirement"),
     ("proofs/mb/stop_limit.smt2", "REQ-MB-001 :", "REQ-MB-007 :", "proofs/mb/stop_limit.smt2",
      "@obligation stop_limit_behind_rear (line 1)", "unknown requirement REQ-MB-007"),
     # analysis results
@@ -199,9 +199,9 @@ def test_dangling_and_inconsistent_links(tree, trace, file, old, new, efile, ent
 
 @pytest.mark.parametrize("file, old, new, spec_file, rid, fragment", [
     ("results/analysis/residual_error.json", '"REQ-TG-002", "REQ-TG-004"', '"REQ-TG-002"',
-     "telegram.yaml", "REQ-TG-004", "verification 'analysis': no analysis result names it"),
+     "tg.yaml", "REQ-TG-004", "verification 'analysis': no analysis result names it"),
     ("proofs/mb/stop_limit.smt2", "; @obligation", "; obligation",
-     "moving_block.yaml", "REQ-MB-001", "verification 'proof': no proof obligation names it"),
+     "mb.yaml", "REQ-MB-001", "verification 'proof': no proof obligation names it"),
 ])
 def test_missing_link_kind(tree, trace, file, old, new, spec_file, rid, fragment):
     root = tree()
@@ -265,7 +265,7 @@ def test_flag_does_not_hide_source_problems_or_bad_results(tree, trace):
     shutil.rmtree(root / "results" / "vectors")
     r = trace(root, "--allow-missing-results")
     assert r.rc == 1
-    assert r.has("spec/requirements/tg.yaml", "REQ-TG-001", "SIL-4 requirement has no")
+    assert r.has("spec/requirements/tg.yaml", "REQ-TG-001", "SIL-4 runtime requirement has no")
     root = tree("violated_property")
     r = trace(root, "--allow-missing-results")
     assert r.rc == 1 and r.has("spin/demo.json", "property REQ_TG_001_repetition", "violated")
@@ -287,7 +287,7 @@ def test_invalid_spec_stops_before_tracing(tree, trace):
     r = trace(tree("unknown_hazard"))
     assert r.rc == 1
     assert r.trace is None
-    assert r.has("requirements/moving_block.yaml", "REQ-MB-001", "unknown hazard HAZ-009")
+    assert r.has("requirements/mb.yaml", "REQ-MB-001", "unknown hazard HAZ-009")
 
 
 def test_tags_in_prose_and_doc_examples_are_not_links(tree, trace):
@@ -300,7 +300,7 @@ def test_tags_in_prose_and_doc_examples_are_not_links(tree, trace):
 
 def test_disabled_test_does_not_count(tree, trace):
     root = tree()
-    _edit(root / "cpp/tests/unit/demo/demo_test.cpp", "TEST(Sequence, RejectsRepetition)",
+    _edit(root / "cpp/runtime/demo/tests/demo_test.cpp", "TEST(Sequence, RejectsRepetition)",
           "TEST(Sequence, DISABLED_RejectsRepetition)")
     r = trace(root)
     assert r.rc == 1
@@ -353,3 +353,38 @@ def test_analysis_case_missing_its_target_fails(tree, trace):
     assert r.rc == 1
     assert r.has("analysis/residual_error.json", "cases[1]", "target not met")
     assert _req(r, "REQ-TG-004")["status"] == "error"
+
+
+def test_offline_code_never_implements_a_runtime_requirement(tree, trace):
+    """An @implements under cpp/offline is a tool link, never the code of a runtime
+    requirement: the SIL-4 requirement REQ-TG-001 stays unimplemented and the error names the
+    offline file."""
+    root = tree("sil4_no_code")
+    tool = root / "cpp/offline/demo/src/demo_study.cpp"
+    tool.parent.mkdir(parents=True)
+    tool.write_text("// @implements REQ-TG-001\nint DemoStudy() { return 1; }\n", encoding="utf-8")
+    r = trace(root)
+    assert r.rc == 1
+    assert r.has("spec/requirements/tg.yaml", "REQ-TG-001",
+                 "SIL-4 runtime requirement has no @implements unit under cpp/runtime (offline code "
+                 "never implements a runtime requirement: cpp/offline/demo/src/demo_study.cpp)")
+    data = json.loads((root / "out" / "trace.json").read_text(encoding="utf-8"))
+    tg1 = next(x for x in data["requirements"] if x["id"] == "REQ-TG-001")
+    assert tg1["links"]["code"] == []
+    assert tg1["links"]["tool"] == [{"file": "cpp/offline/demo/src/demo_study.cpp", "unit": "DemoStudy"}]
+
+
+def test_offline_requirement_needs_an_offline_tool(tree, trace):
+    """implemented_by: offline exempts a requirement from runtime code only if an offline tool
+    implements it; runtime code does not count for it either."""
+    root = tree()
+    _edit(root / "spec/requirements/tg.yaml", "id: REQ-TG-002\n", "id: REQ-TG-002\n    implemented_by: offline\n")
+    r = trace(root)
+    assert r.rc == 1
+    assert r.has("spec/requirements/tg.yaml", "REQ-TG-002",
+                 "implemented_by offline: no @implements unit under cpp/offline names it")
+    tool = root / "cpp/offline/demo/tools/check_data.cpp"
+    tool.parent.mkdir(parents=True)
+    tool.write_text("// @implements REQ-TG-002\nint CheckData() { return 0; }\n", encoding="utf-8")
+    r = trace(root)
+    assert r.rc == 0, r.err

@@ -42,7 +42,7 @@ def test_valid_fixture_passes_and_returns_model(tree, cli):
     assert sorted(model["requirements"]) == ["REQ-MB-001", "REQ-TG-001", "REQ-TG-002",
                                              "REQ-TG-003", "REQ-TG-004"]
     assert model["requirements"]["REQ-MB-001"]["area"] == "MB"
-    assert model["requirements"]["REQ-TG-001"]["file"].endswith("requirements/telegram.yaml")
+    assert model["requirements"]["REQ-TG-001"]["file"].endswith("requirements/tg.yaml")
     assert sorted(model["hazards"]) == ["HAZ-001", "HAZ-002", "HAZ-003"]
     assert sorted(model["assumptions"]) == ["ASM-001", "ASM-002"]
     assert sorted(model["justifications"]) == ["UR-TG-001"]
@@ -54,16 +54,16 @@ def test_valid_fixture_passes_and_returns_model(tree, cli):
 @pytest.mark.parametrize("case, file, entry, fragment", [
     ("malformed_yaml", "hazards/hazards.yaml", "line 5", "malformed YAML"),
     ("duplicate_key", "assumptions/assumptions.yaml", "line 9", "duplicate key 'title'"),
-    ("duplicate_id", "requirements/telegram_extra.yaml", "REQ-TG-001",
+    ("duplicate_id", "requirements/tg_extra.yaml", "REQ-TG-001",
      "duplicate id (first defined in"),
-    ("bad_id", "requirements/telegram.yaml", "REQ-TG-03", "does not match"),
-    ("unknown_hazard", "requirements/moving_block.yaml", "REQ-MB-001",
+    ("bad_id", "requirements/tg.yaml", "REQ-TG-03", "does not match"),
+    ("unknown_hazard", "requirements/mb.yaml", "REQ-MB-001",
      "hazards[1]: unknown hazard HAZ-009"),
-    ("unknown_asm", "requirements/moving_block.yaml", "REQ-MB-001",
+    ("unknown_asm", "requirements/mb.yaml", "REQ-MB-001",
      "source[1]: unknown assumption ASM-042"),
-    ("bad_sil", "requirements/moving_block.yaml", "REQ-MB-001",
+    ("bad_sil", "requirements/mb.yaml", "REQ-MB-001",
      "sil: 5 is greater than the maximum of 4"),
-    ("review_only_sil4", "requirements/telegram.yaml", "REQ-TG-003",
+    ("review_only_sil4", "requirements/tg.yaml", "REQ-TG-003",
      "verified by review alone"),
 ])
 def test_spec_error_classes(tree, cli, case, file, entry, fragment):
@@ -77,8 +77,8 @@ def test_duplicate_id_names_both_files(tree, cli):
     root = tree("duplicate_id")
     r = cli("validate", "--spec", root / "spec")
     line = next(ln for ln in r.lines if "duplicate id" in ln)
-    assert "telegram_extra.yaml: REQ-TG-001:" in line
-    assert "requirements/telegram.yaml)" in line
+    assert "tg_extra.yaml: REQ-TG-001:" in line
+    assert "requirements/tg.yaml)" in line
 
 
 def test_duplicate_id_within_one_file(tree, cli):
@@ -92,29 +92,29 @@ def test_duplicate_id_within_one_file(tree, cli):
 
 @pytest.mark.parametrize("old, new, file, entry, fragment", [
     # id area must match the file's area
-    ("id: REQ-TG-004", "id: REQ-MB-004", "requirements/telegram.yaml", "REQ-MB-004",
+    ("id: REQ-TG-004", "id: REQ-MB-004", "requirements/tg.yaml", "REQ-MB-004",
      "does not match the file's area TG"),
     # unknown verification method (schema enum)
-    ("verification: [analysis]", "verification: [simulation]", "requirements/telegram.yaml",
+    ("verification: [analysis]", "verification: [simulation]", "requirements/tg.yaml",
      "REQ-TG-004", "verification[0]: 'simulation' is not one of"),
     # source must cite D1-D5 §, an ASM or a named standard
-    ("source: [D5 §6]", "source: [the prototype report]", "requirements/telegram.yaml",
+    ("source: [D5 §6]", "source: [the prototype report]", "requirements/tg.yaml",
      "REQ-TG-004", "source[0] 'the prototype report' cites no D1-D5 section"),
     # a D-citation needs a section
-    ("source: [D5 §6]", "source: [D5]", "requirements/telegram.yaml", "REQ-TG-004",
+    ("source: [D5 §6]", "source: [D5]", "requirements/tg.yaml", "REQ-TG-004",
      "cites no D1-D5 section"),
     # malformed reference inside free text
     ("text: The residual error rate is below the target.",
      "text: The residual error rate is below the target (ASM-TG-003).",
-     "requirements/telegram.yaml", "REQ-TG-004", "text: malformed reference 'ASM-TG-003'"),
+     "requirements/tg.yaml", "REQ-TG-004", "text: malformed reference 'ASM-TG-003'"),
     # dangling requirement reference inside free text
-    ("(see REQ-TG-002)", "(see REQ-TG-042)", "requirements/telegram.yaml", "REQ-TG-001",
+    ("(see REQ-TG-002)", "(see REQ-TG-042)", "requirements/tg.yaml", "REQ-TG-001",
      "text: unknown requirement REQ-TG-042"),
     # missing required field
-    ("    sil: 2\n", "", "requirements/telegram.yaml", "REQ-TG-003",
+    ("    sil: 2\n", "", "requirements/tg.yaml", "REQ-TG-003",
      "'sil' is a required property"),
     # misspelt field
-    ("    hazards: []\n", "    hazard: []\n", "requirements/telegram.yaml", "REQ-TG-003",
+    ("    hazards: []\n", "    hazard: []\n", "requirements/tg.yaml", "REQ-TG-003",
      "'hazard' was unexpected"),
 ])
 def test_requirement_rules(tree, cli, old, new, file, entry, fragment):
@@ -153,17 +153,17 @@ def test_parameter_rules(tree, cli, old, new, entry, fragment):
     _edit(root / "spec/parameters/tg.yaml", old, new)
     r = cli("validate", "--spec", root / "spec")
     assert r.rc == 1
-    assert r.has("parameters/telegram.yaml", entry, fragment), r.err
+    assert r.has("parameters/tg.yaml", entry, fragment), r.err
 
 
 def test_two_parameter_files_for_one_area(tree, cli):
     root = tree()
     src = root / "spec/parameters/tg.yaml"
-    (root / "spec/parameters/telegram2.yaml").write_text(src.read_text(encoding="utf-8"),
+    (root / "spec/parameters/tg2.yaml").write_text(src.read_text(encoding="utf-8"),
                                                          encoding="utf-8")
     r = cli("validate", "--spec", root / "spec")
     assert r.rc == 1
-    assert r.has("parameters/telegram2.yaml", "area", "also declared by")
+    assert r.has("parameters/tg2.yaml", "area", "also declared by")
 
 
 def test_justification_rules(tree, cli):
@@ -171,7 +171,7 @@ def test_justification_rules(tree, cli):
     _edit(root / "spec/justifications/tg.yaml", "id: UR-TG-001", "id: UR-XX-001")
     r = cli("validate", "--spec", root / "spec")
     assert r.rc == 1
-    assert r.has("justifications/telegram.yaml", "UR-XX-001", "does not match")
+    assert r.has("justifications/tg.yaml", "UR-XX-001", "does not match")
 
 
 def test_yml_extension_is_not_silently_ignored(tree, cli):
@@ -199,10 +199,10 @@ def test_all_errors_are_collected_across_files(tree, cli):
     assert r.rc == 1
     assert r.has("hazards/hazards.yaml", "line 5", "malformed YAML")
     assert r.has("assumptions/assumptions.yaml", "line 9", "duplicate key")
-    assert r.has("requirements/moving_block.yaml", "REQ-MB-001", "unknown assumption ASM-042")
-    assert r.has("requirements/telegram.yaml", "REQ-TG-03", "does not match")
+    assert r.has("requirements/mb.yaml", "REQ-MB-001", "unknown assumption ASM-042")
+    assert r.has("requirements/tg.yaml", "REQ-TG-03", "does not match")
     # the unreadable hazards file leaves every hazard reference dangling: reported too
-    assert r.has("requirements/telegram.yaml", "REQ-TG-001", "unknown hazard HAZ-001")
+    assert r.has("requirements/tg.yaml", "REQ-TG-001", "unknown hazard HAZ-001")
     assert len(r.lines) >= 6
     assert r.lines[-1].startswith("validate: ")
 
@@ -211,7 +211,7 @@ def test_validate_spec_raises_first_error_with_count(tree):
     root = tree("unknown_hazard", "review_only_sil4")
     with pytest.raises(SpecError) as exc:
         validate.validate_spec(root / "spec")
-    assert exc.value.file.endswith("moving_block.yaml")
+    assert exc.value.file.endswith("mb.yaml")
     assert exc.value.entry == "REQ-MB-001"
     assert exc.value.reason.endswith("unknown hazard HAZ-009 (and 1 more)")
 
@@ -226,7 +226,7 @@ def test_gen_params_refuses_an_invalid_spec(tree, tmp_path, cli):
     assert r.rc == 1
     assert len(r.lines) == 1
     assert r.lines[0].startswith("railproof_testgen: error: ")
-    assert "moving_block.yaml: REQ-MB-001: hazards[1]: unknown hazard HAZ-009" in r.lines[0]
+    assert "mb.yaml: REQ-MB-001: hazards[1]: unknown hazard HAZ-009" in r.lines[0]
 
 
 def test_gen_params_on_valid_spec(tree, tmp_path, cli):

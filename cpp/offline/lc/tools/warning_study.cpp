@@ -28,7 +28,7 @@ using railproof::offline::InputError;
 
 void PrintHelp() {
   std::printf(
-      "usage: warning_study --line FILE.json --timetable FILE.yaml --trains-dir DIR --json OUT.json\n"
+      "usage: warning_study --line FILE.json --timetable FILE.json --trains-dir DIR --json OUT.json\n"
       "                     [--svg-dir DIR] [--lead-sweep S,S,...] [--quiet] [--help]\n"
       "\n"
       "Warning-time study of level crossings (REQ-LC-017, also REQ-LC-002/005/008/015). Every\n"
@@ -40,7 +40,7 @@ void PrintHelp() {
       "counted (runtime braking patterns and supervision).\n"
       "\n"
       "  --line FILE        generated line JSON (build/gen/lines/<line>.json)\n"
-      "  --timetable FILE   timetable (spec/timetables/<line>.yaml, schema railproof/timetable/1)\n"
+      "  --timetable FILE   generated timetable JSON (build/gen/timetables/<name>.json)\n"
       "  --trains-dir DIR   generated train JSON (build/gen/trains)\n"
       "  --json OUT         result JSON (requirements, per-method statistics, requirement rows,\n"
       "                     per-crossing rows with meets_target, every passage)\n"

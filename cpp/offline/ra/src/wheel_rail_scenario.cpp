@@ -1,5 +1,11 @@
 // Wheel-rail scenario loader (spec/wheelrail/README.md): every failure names the file, the
-// entry and the reason.
+// entry and the reason. The format is the schema's (spec/schemas/wheelrail_scenario.schema.json,
+// applied with the requirements named by railproof_testgen validate); this loader keeps what
+// the simulation needs when it is run by hand on a file the validator has not seen
+// (spec/design/data.md): the type of every value, the ranges that keep the Box2D model and
+// its unit conversions defined, and the rules between values the schema cannot say (order,
+// the vertical curves fitting between the change points, the car inside the alignment, the
+// step dividing the IMU period, fields that belong to one fault type).
 #include <algorithm>
 #include <cmath>
 #include <fstream>
@@ -30,31 +36,6 @@ double RangedKey(const JsonNode& n, std::string_view key, double def, double lo,
   return k ? Ranged(*k, lo, hi) : def;
 }
 
-// "REQ-" + 2..3 capitals + "-" + 3 digits (std::regex avoided: g++ 12 false warnings).
-bool IsRequirementId(const std::string& id) {
-  if (id.size() < 10 || id.size() > 11 || id.rfind("REQ-", 0) != 0) {
-    return false;
-  }
-  const std::size_t dash = id.find('-', 4);
-  if (dash != 6 && dash != 7) {
-    return false;
-  }
-  for (std::size_t i = 4; i < dash; ++i) {
-    if (id[i] < 'A' || id[i] > 'Z') {
-      return false;
-    }
-  }
-  if (id.size() - dash - 1 != 3) {
-    return false;
-  }
-  for (std::size_t i = dash + 1; i < id.size(); ++i) {
-    if (id[i] < '0' || id[i] > '9') {
-      return false;
-    }
-  }
-  return true;
-}
-
 std::string Fmt(double v) {
   std::ostringstream os;
   os << v;
@@ -62,7 +43,6 @@ std::string Fmt(double v) {
 }
 
 void ParseVertical(const JsonNode& n, WheelRailScenario& sc) {
-  n.AllowOnly({"begin_m", "end_m", "vertical_curve_radius_m", "gradients"});
   auto& v = sc.vertical;
   v.begin_m = Ranged(n.Key("begin_m"), -1e7, 1e7);
   v.end_m = Ranged(n.Key("end_m"), -1e7, 1e7);
@@ -75,7 +55,6 @@ void ParseVertical(const JsonNode& n, WheelRailScenario& sc) {
     n.Key("gradients").Fail("at least one gradient expected");
   }
   for (const auto& e : arr) {
-    e.AllowOnly({"from_m", "permille", "note"});
     GradientPoint g;
     g.from_m = e.Key("from_m").Number();
     const auto pn = e.Key("permille");
@@ -113,7 +92,6 @@ void ParseVertical(const JsonNode& n, WheelRailScenario& sc) {
 
 void ParseCurves(const JsonNode& n, WheelRailScenario& sc) {
   for (const auto& e : n.Array()) {
-    e.AllowOnly({"begin_m", "end_m", "radius_m", "cant_mm", "transition_m", "note"});
     HorizontalCurve c;
     c.begin_m = e.Key("begin_m").Number();
     c.end_m = e.Key("end_m").Number();
@@ -139,7 +117,6 @@ void ParseCurves(const JsonNode& n, WheelRailScenario& sc) {
 }
 
 void ParseRail(const JsonNode& n, WheelRailScenario& sc) {
-  n.AllowOnly({"condition", "zones"});
   const auto cn = n.Key("condition");
   const std::string cond = cn.String();
   if (cond == "wet") {
@@ -151,7 +128,6 @@ void ParseRail(const JsonNode& n, WheelRailScenario& sc) {
   }
   if (const auto z = n.OptKey("zones")) {
     for (const auto& e : z->Array()) {
-      e.AllowOnly({"begin_m", "end_m", "factor", "from_s", "to_s", "note"});
       AdhesionZone a;
       a.begin_m = e.Key("begin_m").Number();
       a.end_m = e.Key("end_m").Number();
@@ -178,7 +154,6 @@ void ParseRail(const JsonNode& n, WheelRailScenario& sc) {
 }
 
 void ParseAdhesion(const JsonNode& n, WheelRailScenario& sc) {
-  n.AllowOnly({"wet_factor", "peak_creep", "tail_creep", "tail_ratio", "creep_floor_mps"});
   auto& a = sc.adhesion;
   a.wet_factor = RangedKey(n, "wet_factor", a.wet_factor, 0.1, 1.0);
   a.peak_creep = RangedKey(n, "peak_creep", a.peak_creep, 0.001, 0.1);
@@ -191,11 +166,6 @@ void ParseAdhesion(const JsonNode& n, WheelRailScenario& sc) {
 }
 
 void ParseVehicle(const JsonNode& n, WheelRailScenario& sc) {
-  n.AllowOnly({"length_m", "bogie_centres_m", "axle_spacing_m", "wheel_diameter_m", "body_mass_kg",
-               "bogie_mass_kg", "wheelset_mass_kg", "wheelset_inertia_kgm2", "body_cog_height_m",
-               "primary_hz", "primary_damping", "secondary_hz", "secondary_damping", "roll_coefficient",
-               "motored", "max_traction_force_n", "max_power_w", "max_brake_force_n", "resistance_a_n",
-               "resistance_b_ns_m", "resistance_c_ns2_m2", "max_speed_kmh"});
   auto& v = sc.vehicle;
   v.length_m = RangedKey(n, "length_m", v.length_m, 5.0, 40.0);
   v.bogie_centres_m = RangedKey(n, "bogie_centres_m", v.bogie_centres_m, 3.0, 30.0);
@@ -241,7 +211,6 @@ void ParseDriver(const JsonNode& n, WheelRailScenario& sc) {
     n.Fail("at least one driver command expected");
   }
   for (const auto& e : arr) {
-    e.AllowOnly({"t_s", "traction", "brake", "ramp_s", "hold_kmh", "note"});
     DriverCommand d;
     const auto tn = e.Key("t_s");
     d.t_s = Ranged(tn, 0.0, 1e6);
@@ -263,7 +232,6 @@ void ParseDriver(const JsonNode& n, WheelRailScenario& sc) {
 }
 
 void ParseSlipControl(const JsonNode& n, WheelRailScenario& sc) {
-  n.AllowOnly({"enabled", "creep_threshold", "reduce_per_s", "recover_per_s", "min_factor"});
   auto& s = sc.slip_control;
   s.enabled = n.Key("enabled").Bool();
   s.creep_threshold = RangedKey(n, "creep_threshold", s.creep_threshold, 0.005, 0.5);
@@ -273,8 +241,6 @@ void ParseSlipControl(const JsonNode& n, WheelRailScenario& sc) {
 }
 
 void ParseImu(const JsonNode& n, WheelRailScenario& sc) {
-  n.AllowOnly({"enabled", "accel_bias_mps2", "accel_noise_mps2", "accel_drift_mps2_per_sqrt_s", "rate_bias_deg_s",
-               "rate_noise_deg_s", "rate_drift_deg_s_per_sqrt_s"});
   auto& m = sc.imu;
   if (const auto e = n.OptKey("enabled")) {
     m.enabled = e->Bool();
@@ -288,7 +254,6 @@ void ParseImu(const JsonNode& n, WheelRailScenario& sc) {
 }
 
 void ParseTg(const JsonNode& n, WheelRailScenario& sc) {
-  n.AllowOnly({"axle", "teeth", "calibration_error_ppm"});
   if (const auto a = n.OptKey("axle")) {
     const auto v = a->Int();
     if (v < 0 || v >= kWheelRailAxles) {
@@ -323,7 +288,6 @@ SensorFaultKind FaultKind(const JsonNode& n) {
 
 void ParseFaults(const JsonNode& n, WheelRailScenario& sc) {
   for (const auto& e : n.Array()) {
-    e.AllowOnly({"type", "from_s", "to_s", "samples", "pulses", "value", "note"});
     SensorFault f;
     f.kind = FaultKind(e.Key("type"));
     f.from_s = Ranged(e.Key("from_s"), 0.0, 1e6);
@@ -369,7 +333,6 @@ void ParseFaults(const JsonNode& n, WheelRailScenario& sc) {
 }
 
 void ParseOdometry(const JsonNode& n, WheelRailScenario& sc) {
-  n.AllowOnly({"detect_threshold_mm_s2", "max_compensation_s", "start_points", "rate_error_udeg_s"});
   if (const auto t = n.OptKey("detect_threshold_mm_s2")) {
     sc.odometry.detect_threshold_mm_s2 = std::llround(Ranged(*t, 50.0, 2000.0));
   }
@@ -398,9 +361,6 @@ void ParseOdometry(const JsonNode& n, WheelRailScenario& sc) {
 WheelRailScenario ParseWheelRailScenario(std::string_view text, const std::string& file) {
   const nlohmann::json doc = JsonNode::Parse(text, file);
   const JsonNode root(doc, "", file);
-  root.AllowOnly({"schema", "name", "description", "requirements", "expect_safe_reaction", "duration_s", "step_ms",
-                  "seed", "initial_front_m", "initial_speed_kmh", "vertical", "curves", "rail", "adhesion",
-                  "balises", "vehicle", "driver", "slip_control", "imu", "tg", "faults", "truth", "odometry"});
   WheelRailScenario sc;
   sc.file = file;
   const auto schema = root.Key("schema");
@@ -408,22 +368,11 @@ WheelRailScenario ParseWheelRailScenario(std::string_view text, const std::strin
     schema.Fail("expected '" + std::string(kWheelRailSchema) + "', got '" + schema.String() + "'");
   }
   sc.name = root.Key("name").String();
-  if (sc.name.empty()) {
-    root.Key("name").Fail("empty name");
-  }
   if (const auto d = root.OptKey("description")) {
     sc.description = d->String();
   }
-  const auto reqs = root.Key("requirements");
-  for (const auto& r : reqs.Array()) {
-    const std::string id = r.String();
-    if (!IsRequirementId(id)) {
-      r.Fail("not a requirement id: '" + id + "'");
-    }
-    sc.requirements.push_back(id);
-  }
-  if (sc.requirements.empty()) {
-    reqs.Fail("name at least one requirement exercised");
+  for (const auto& r : root.Key("requirements").Array()) {
+    sc.requirements.push_back(r.String());
   }
   if (const auto e = root.OptKey("expect_safe_reaction")) {
     sc.expect_safe_reaction = e->Bool();
@@ -470,7 +419,6 @@ WheelRailScenario ParseWheelRailScenario(std::string_view text, const std::strin
   sc.initial_speed_kmh = RangedKey(root, "initial_speed_kmh", 0.0, 0.0, sc.vehicle.max_speed_kmh);
   if (const auto b = root.OptKey("balises")) {
     for (const auto& e : b->Array()) {
-      e.AllowOnly({"id", "position_m"});
       BalisePoint p;
       p.id = e.Key("id").String();
       const auto pn = e.Key("position_m");
@@ -498,7 +446,6 @@ WheelRailScenario ParseWheelRailScenario(std::string_view text, const std::strin
     ParseFaults(*f, sc);
   }
   if (const auto t = root.OptKey("truth")) {
-    t->AllowOnly({"event_creep", "event_min_s"});
     sc.truth.event_creep = RangedKey(*t, "event_creep", sc.truth.event_creep, 0.001, 1.0);
     sc.truth.event_min_s = RangedKey(*t, "event_min_s", sc.truth.event_min_s, 0.0, 60.0);
   }

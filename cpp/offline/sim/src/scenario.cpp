@@ -1,4 +1,11 @@
-// Scenario file reader (spec/scenarios/README.md).
+// Scenario file reader (spec/scenarios/README.md). The format is the schema's
+// (spec/schemas/scenario.schema.json, applied with the line, stations and routes named by
+// railproof_testgen validate); this reader keeps what the simulation needs when it is run by
+// hand on a file the validator has not seen (spec/design/data.md): the type of every value,
+// the ranges that keep its arithmetic and its containers defined (positive divisors, times
+// and lengths that convert to integer ms and mm, bounded copies, 16-bit train addresses other
+// than the ground's), the rules between values the schema cannot say (windows, order, train
+// ids) and the fit to the line it is given.
 #include "railproof/sim/scenario.hpp"
 
 #include <algorithm>
@@ -32,11 +39,17 @@ namespace {
 
 constexpr double kMaxDurationS = 7.0 * 24.0 * 3600.0;
 
+std::string Num(double v) {
+  std::ostringstream os;
+  os << v;
+  return os.str();
+}
+
 double Positive(const JsonNode& n, double max = std::numeric_limits<double>::max()) {
   const double v = n.Number();
   if (!(v > 0.0) || v > max) {
-    n.Fail("must be positive" + (max < std::numeric_limits<double>::max() ? " and at most " + std::to_string(max) : std::string()) +
-           ", got " + std::to_string(v));
+    n.Fail("must be positive" + (max < std::numeric_limits<double>::max() ? " and at most " + Num(max) : std::string()) +
+           ", got " + Num(v));
   }
   return v;
 }
@@ -44,7 +57,7 @@ double Positive(const JsonNode& n, double max = std::numeric_limits<double>::max
 double NonNegative(const JsonNode& n) {
   const double v = n.Number();
   if (v < 0.0) {
-    n.Fail("must not be negative, got " + std::to_string(v));
+    n.Fail("must not be negative, got " + Num(v));
   }
   return v;
 }
@@ -52,14 +65,14 @@ double NonNegative(const JsonNode& n) {
 double Probability(const JsonNode& n) {
   const double v = n.Number();
   if (v < 0.0 || v > 1.0) {
-    n.Fail("must be a probability in [0, 1], got " + std::to_string(v));
+    n.Fail("must be a probability in [0, 1], got " + Num(v));
   }
   return v;
 }
 
 std::int64_t SecondsToMs(const JsonNode& n, double s) {
   if (s > kMaxDurationS) {
-    n.Fail("time " + std::to_string(s) + " s too large");
+    n.Fail("time " + Num(s) + " s too large");
   }
   return static_cast<std::int64_t>(std::llround(s * 1000.0));
 }
@@ -75,8 +88,6 @@ std::int64_t PositiveMs(const JsonNode& n) {
 }
 
 TrainSpec ReadTrain(const JsonNode& n, const std::string& entry) {
-  n.AllowOnly({"id", "length_m", "max_speed_kmh", "accel_mps2", "service_decel_mps2", "emergency_decel_mps2",
-               "initial_front_m", "enter_s", "depart_s", "stops", "speed_cap_kmh", "resistance", "repeat"});
   TrainSpec t;
   t.entry = entry;
   const JsonNode idn = n.Key("id");
@@ -105,7 +116,6 @@ TrainSpec ReadTrain(const JsonNode& n, const std::string& entry) {
   }
   if (auto sn = n.OptKey("stops")) {
     for (const auto& s : sn->Array()) {
-      s.AllowOnly({"station", "dwell_s"});
       const JsonNode dw = s.Key("dwell_s");
       t.stops.push_back(StopSpec{s.Key("station").String(), SecondsToMs(dw, NonNegative(dw))});
     }
@@ -114,7 +124,6 @@ TrainSpec ReadTrain(const JsonNode& n, const std::string& entry) {
     t.speed_cap_mps = Positive(*c, 400.0) / 3.6;
   }
   if (auto r = n.OptKey("resistance")) {
-    r->AllowOnly({"a0", "a1", "a2"});
     t.performance.resistance = Resistance{NonNegative(r->Key("a0")), NonNegative(r->Key("a1")), NonNegative(r->Key("a2"))};
   }
   return t;
@@ -127,7 +136,6 @@ FaultSpec ReadFault(const JsonNode& n, const std::string& entry) {
   const std::string type = tn.String();
   if (type == "radio_loss" || type == "tracking_loss") {
     f.type = type == "radio_loss" ? FaultType::kRadioLoss : FaultType::kTrackingLoss;
-    n.AllowOnly({"type", "train", "from_s", "to_s", "note"});
     const JsonNode trn = n.Key("train");
     const std::int64_t id = trn.Int();
     if (id < 0 || id > 0xFFFF) {
@@ -136,7 +144,6 @@ FaultSpec ReadFault(const JsonNode& n, const std::string& entry) {
     f.train = static_cast<std::uint16_t>(id);
   } else if (type == "possession") {
     f.type = FaultType::kPossession;
-    n.AllowOnly({"type", "begin_m", "end_m", "from_s", "to_s", "note"});
     f.begin_mm = MetresToMm(NonNegative(n.Key("begin_m")));
     const JsonNode en = n.Key("end_m");
     f.end_mm = MetresToMm(NonNegative(en));
@@ -145,7 +152,6 @@ FaultSpec ReadFault(const JsonNode& n, const std::string& entry) {
     }
   } else if (type == "speed_restriction") {
     f.type = FaultType::kSpeedRestriction;
-    n.AllowOnly({"type", "begin_m", "end_m", "speed_kmh", "from_s", "to_s", "note"});
     f.begin_mm = MetresToMm(NonNegative(n.Key("begin_m")));
     const JsonNode en = n.Key("end_m");
     f.end_mm = MetresToMm(NonNegative(en));
@@ -155,7 +161,6 @@ FaultSpec ReadFault(const JsonNode& n, const std::string& entry) {
     f.speed_mps = Positive(n.Key("speed_kmh"), 400.0) / 3.6;
   } else if (type == "siding_request") {
     f.type = FaultType::kSidingRequest;
-    n.AllowOnly({"type", "route", "from_s", "to_s", "note"});
     if (auto r = n.OptKey("route")) {
       f.route = r->Int();
       if (f.route <= 0) {
@@ -180,9 +185,6 @@ FaultSpec ReadFault(const JsonNode& n, const std::string& entry) {
 Scenario ParseScenario(std::string_view text, const std::string& file) {
   const nlohmann::json doc = JsonNode::Parse(text, file);
   const JsonNode root(doc, "", file);
-  root.AllowOnly({"schema", "name", "description", "line", "running_line", "duration_s", "step_ms", "seed",
-                  "ground_cycle_ms", "report_period_ms", "margin_policy", "channel", "supervision", "sample_ms",
-                  "trains", "faults", "gap", "handover_secure_ahead_m", "boundary_accepted"});
   Scenario sc;
   sc.file = file;
   const JsonNode schema = root.Key("schema");
@@ -190,13 +192,11 @@ Scenario ParseScenario(std::string_view text, const std::string& file) {
     schema.Fail("unsupported schema '" + schema.String() + "', expected '" + std::string(kScenarioSchema) + "'");
   }
   sc.name = root.Key("name").String();
-  if (sc.name.empty()) {
-    root.Key("name").Fail("empty name");
-  }
   if (auto d = root.OptKey("description")) {
     sc.description = d->String();
   }
   sc.line = root.Key("line").String();
+  // the line file is <lines-dir>/<line>.json: no other file may be opened
   if (sc.line.empty() || sc.line.find_first_of("/\\") != std::string::npos) {
     root.Key("line").Fail("line must be a plain line name (file <lines-dir>/<line>.json)");
   }
@@ -249,7 +249,6 @@ Scenario ParseScenario(std::string_view text, const std::string& file) {
 
   {
     const JsonNode ch = root.Key("channel");
-    ch.AllowOnly({"loss_probability", "min_delay_ms", "max_delay_ms", "corrupt_probability"});
     sc.channel.loss_probability = Probability(ch.Key("loss_probability"));
     if (auto c = ch.OptKey("corrupt_probability")) {
       sc.channel.corrupt_probability = Probability(*c);
@@ -267,7 +266,6 @@ Scenario ParseScenario(std::string_view text, const std::string& file) {
     }
   }
   if (auto sv2 = root.OptKey("supervision")) {
-    sv2->AllowOnly({"margin_m", "free_running_s", "emergency_free_running_s"});
     if (auto m = sv2->OptKey("margin_m")) {
       sc.supervision.margin_m = NonNegative(*m);
     }
@@ -291,7 +289,6 @@ Scenario ParseScenario(std::string_view text, const std::string& file) {
       std::int64_t count = 1;
       double interval_s = 0.0;
       if (auto rp = n.OptKey("repeat")) {
-        rp->AllowOnly({"count", "interval_s"});
         const JsonNode cn = rp->Key("count");
         count = cn.Int();
         if (count < 1 || count > 1000) {
@@ -329,7 +326,6 @@ Scenario ParseScenario(std::string_view text, const std::string& file) {
     }
   }
   if (auto gn = root.OptKey("gap")) {
-    gn->AllowOnly({"leader", "follower", "from_s", "to_s"});
     GapSpec g;
     for (auto [key, out] : {std::pair<const char*, std::uint16_t*>{"leader", &g.leader}, {"follower", &g.follower}}) {
       const JsonNode idn = gn->Key(key);

@@ -18,15 +18,7 @@
 
 namespace {
 
-using railproof::br::DefaultSupervisionParams;
-using railproof::br::DriverInputs;
-using railproof::br::GradientSegment;
-using railproof::br::PatternCalculator;
-using railproof::br::PositionEstimate;
-using railproof::br::ProfileVerdict;
-using railproof::br::RestrictionSegment;
-using railproof::br::Supervisor;
-using railproof::br::TrainData;
+using namespace railproof::br;  // NOLINT(google-build-using-namespace)
 
 constexpr std::int64_t kOrigin = 10'000'000;       // train front at km 10
 constexpr std::int64_t kLookAhead = 5'000'000;     // params::br::lookahead_mm

@@ -30,7 +30,8 @@
 //
 // Seeded faults (negative tests, cpp/runtime/br/tests/test_patterns.cpp kills each one):
 // FAULT_BR_NO_FREE_RUNNING, FAULT_BR_GRADIENT_FRONT_ONLY, FAULT_BR_RESTRICTION_FRONT_RELEASE,
-// FAULT_BR_NO_SPEED_ALLOWANCE. Never defined in the railproof_braking library.
+// FAULT_BR_NO_SPEED_ALLOWANCE; active only in the test-only schemata variant
+// (spec/design/seeded-faults.md).
 #include "railproof/core/seeded_fault.hpp"
 #include "railproof/br/patterns.hpp"
 
@@ -606,7 +607,7 @@ std::int64_t PatternCalculator::PatternSpeed(Pattern pattern, std::int64_t super
   return SpeedAt(q, supervised_front_mm);
 }
 
-// @implements REQ-BR-001 REQ-BR-002 REQ-BR-003 REQ-BR-004 REQ-BR-007 REQ-BR-008 REQ-BR-012
+// @implements REQ-BR-001 REQ-BR-002 REQ-BR-003 REQ-BR-004 REQ-BR-007 REQ-BR-008 REQ-BR-012 REQ-BR-014
 Evaluation PatternCalculator::Evaluate(const PositionEstimate& position,
                                        std::optional<std::int64_t> stop_limit_mm) const noexcept {
   Evaluation out;

@@ -1,5 +1,5 @@
-// Speed supervision decision (spec/design/br.md §4). Seeded faults (negative tests,
-// cpp/tests/conformance/CMakeLists.txt) are compiled in only with their FAULT_BR_* macro.
+// Speed supervision decision (spec/design/br.md §4). Seeded faults RAILPROOF_FAULT(FAULT_BR_*)
+// are active only in the test-only schemata variant (spec/design/seeded-faults.md).
 #include "railproof/core/seeded_fault.hpp"
 #include "railproof/br/supervisor.hpp"
 
@@ -44,7 +44,7 @@ BrakeLevel ServiceLevel(const PatternSpeeds& p, BrakeLevel previous) noexcept {
 
 }  // namespace
 
-// @implements REQ-BR-001 REQ-BR-002 REQ-BR-003 REQ-BR-006
+// @implements REQ-BR-001 REQ-BR-002 REQ-BR-003 REQ-BR-006 REQ-BR-014
 Decision Supervisor::Step(const PatternSpeeds& p, const DriverInputs& in) noexcept {
   Decision d;
   if (latched_) {

@@ -6,8 +6,7 @@
 // (no allocation after Create, determinism) and monotonicity.
 //
 // Kills the seeded faults FAULT_BR_NO_FREE_RUNNING, FAULT_BR_GRADIENT_FRONT_ONLY,
-// FAULT_BR_RESTRICTION_FRONT_RELEASE, FAULT_BR_NO_SPEED_ALLOWANCE (build this file against
-// patterns.cpp compiled with the macro).
+// FAULT_BR_RESTRICTION_FRONT_RELEASE, FAULT_BR_NO_SPEED_ALLOWANCE (ctest unit_fault_<F>: these tests against the schemata variant with the fault selected).
 #include <gtest/gtest.h>
 
 #include <algorithm>

@@ -4,8 +4,7 @@
 // 70 km/h (n_2E = 12) and 30 km/h (n_2E = 5).
 //
 // Kills the seeded faults FAULT_SC_BRAKE_STRICT (AtTheCheckSpeedItBrakes) and
-// FAULT_SC_NO_GATE_TIMEOUT (SilentTgBrakesAfterTheGateTimeout) (build this file against a
-// faulty speed_check.cpp).
+// FAULT_SC_NO_GATE_TIMEOUT (SilentTgBrakesAfterTheGateTimeout) (ctest unit_fault_<F>: these tests against the schemata variant with the fault selected).
 #include <gtest/gtest.h>
 
 #include <array>

@@ -12,6 +12,7 @@
 
 #include <cstdint>
 
+#include "railproof/testing/enum_names.hpp"
 #include "railproof/br/supervisor.hpp"
 
 namespace railproof::br {
@@ -45,13 +46,7 @@ Supervisor Latched() {
 // @verifies REQ-BR-002
 // @verifies REQ-BR-003
 TEST(BrakingSupervisor, LevelNamesOfTheVectors) {
-  EXPECT_STREQ(ToString(BrakeLevel::kNone), "NONE");
-  EXPECT_STREQ(ToString(BrakeLevel::k4N), "4N");
-  EXPECT_STREQ(ToString(BrakeLevel::k5N), "5N");
-  EXPECT_STREQ(ToString(BrakeLevel::k6N), "6N");
-  EXPECT_STREQ(ToString(BrakeLevel::k7N), "7N");
-  EXPECT_STREQ(ToString(BrakeLevel::kEmergency), "EB");
-  EXPECT_STREQ(ToString(static_cast<BrakeLevel>(99)), "INVALID");
+  railproof::testing::ExpectEnumNames<BrakeLevel>(std::array<const char*, 6>{"NONE", "4N", "5N", "6N", "7N", "EB"});
 }
 
 // Step 2-5: at or below every pattern nothing is commanded and nothing shown.

@@ -18,12 +18,10 @@
 
 namespace {
 
-using railproof::core::RestrictionSegment;
-using railproof::lc::CrossingData;
-using railproof::lc::onboard::CrossingProtection;
-using railproof::messages::CrossingReport;
-using railproof::messages::CrossingStatus;
-using railproof::lc::kMaxCrossings;
+using namespace railproof::core;  // NOLINT(google-build-using-namespace)
+using namespace railproof::lc;  // NOLINT(google-build-using-namespace)
+using namespace railproof::lc::onboard;  // NOLINT(google-build-using-namespace)
+using namespace railproof::messages;  // NOLINT(google-build-using-namespace)
 
 constexpr std::int64_t kOrigin = 10'000'000;
 constexpr std::int64_t kLookAhead = 5'000'000;

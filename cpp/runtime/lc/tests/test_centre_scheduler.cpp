@@ -5,8 +5,8 @@
 // earlier), the passage with the tracking plausibility and the warning stop re-sent until
 // acknowledged, typed errors, no heap in the cycle and determinism.
 //
-// Kills the seeded fault FAULT_LC_DEPART_WITHOUT_ALL_ACKS (build this file against
-// railproof_wayside compiled with the macro, linked with railproof_onboard).
+// Kills the seeded fault FAULT_LC_DEPART_WITHOUT_ALL_ACKS (ctest unit_fault_<F>: these tests
+// against the schemata variant with the fault selected).
 #include <gtest/gtest.h>
 
 #include <array>

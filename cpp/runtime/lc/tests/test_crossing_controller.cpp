@@ -7,13 +7,14 @@
 // once, fault reported), typed errors, no heap in the cycle and determinism.
 //
 // Kills the seeded faults FAULT_LC_END_WITH_REQUESTER and FAULT_LC_LATER_UPDATE_WHILE_WARNING
-// (build this file against railproof_wayside compiled with the macro).
+// (ctest unit_fault_<F>: these tests against the schemata variant with the fault selected).
 #include <gtest/gtest.h>
 
 #include <array>
 #include <cstdint>
 #include <vector>
 
+#include "railproof/testing/enum_names.hpp"
 #include "railproof/testing/alloc_counter.hpp"
 #include "railproof/generated/lc_params.hpp"
 #include "railproof/lc/wayside/crossing_controller.hpp"
@@ -497,12 +498,7 @@ TEST(LcCrossingController, TypedErrors) {
   EXPECT_EQ(c.Status().Requesters().size(), 1U);
   EXPECT_EQ(c.Cycle(WithStart(Down(9'500), {{{kId, 1, lc::kMaxClockMs + 1}}})),
             ControllerError::kTimeInvalid);
-  EXPECT_STREQ(ToString(ControllerState::kOpen), "OPEN");
-  EXPECT_STREQ(ToString(ControllerState::kWarning), "WARNING");
-  EXPECT_STREQ(ToString(ControllerState::kClosing), "CLOSING");
-  EXPECT_STREQ(ToString(ControllerState::kClosed), "CLOSED");
-  EXPECT_STREQ(ToString(ControllerState::kOpening), "OPENING");
-  EXPECT_STREQ(ToString(ControllerState::kFailed), "FAILED");
+  railproof::testing::ExpectEnumNames<ControllerState>(std::array<const char*, 6>{"OPEN", "WARNING", "CLOSING", "CLOSED", "OPENING", "FAILED"});
   EXPECT_STREQ(ToString(FailureReason::kBarrierNotUp), "BARRIER_NOT_UP");
 }
 

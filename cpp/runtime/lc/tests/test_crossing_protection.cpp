@@ -8,14 +8,15 @@
 // and determinism.
 //
 // Kills the seeded faults FAULT_LC_CLEAR_WITHOUT_WARNING_TIME, FAULT_LC_STALE_CONFIRMATION and
-// FAULT_LC_WITHDRAW_AT_FRONT (build this file against railproof_onboard compiled with the
-// macro).
+// FAULT_LC_WITHDRAW_AT_FRONT (ctest unit_fault_<F>: these tests against the schemata variant
+// with the fault selected).
 #include <gtest/gtest.h>
 
 #include <array>
 #include <cstdint>
 #include <vector>
 
+#include "railproof/testing/enum_names.hpp"
 #include "railproof/testing/alloc_counter.hpp"
 #include "railproof/generated/lc_params.hpp"
 #include "railproof/lc/onboard/crossing_protection.hpp"
@@ -206,11 +207,7 @@ TEST(LcCrossingProtection, ConfigurationErrors) {
   EXPECT_EQ(c.lookahead_mm, params::lc::crossing_lookahead_mm);
   c.lookahead_mm = 0;
   EXPECT_EQ(CrossingProtection::Create(c).error, ProtectionError::kParameterInvalid);
-  EXPECT_STREQ(ToString(CrossingState::kApproaching), "APPROACHING");
-  EXPECT_STREQ(ToString(CrossingState::kRequested), "REQUESTED");
-  EXPECT_STREQ(ToString(CrossingState::kCleared), "CLEARED");
-  EXPECT_STREQ(ToString(CrossingState::kPassed), "PASSED");
-  EXPECT_STREQ(ToString(CrossingState::kDone), "DONE");
+  railproof::testing::ExpectEnumNames<CrossingState>(std::array<const char*, 5>{"APPROACHING", "REQUESTED", "CLEARED", "PASSED", "DONE"});
   EXPECT_STREQ(ToString(CrossingStatus::kClosed), "CLOSED");
   EXPECT_STREQ(ToString(ProtectionError::kTimeWentBack), "TIME_WENT_BACK");
 }

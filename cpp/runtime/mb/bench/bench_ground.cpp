@@ -19,21 +19,9 @@
 
 namespace {
 
-using railproof::mb::wayside::Capacity;
-using railproof::mb::wayside::CommandStatus;
-using railproof::mb::wayside::ConfigError;
-using railproof::mb::wayside::CycleStatus;
-using railproof::mb::wayside::Direction;
-using railproof::mb::wayside::Ground;
-using railproof::mb::wayside::HandoverConfig;
-using railproof::mb::wayside::InitialPosition;
-using railproof::mb::wayside::LineConfig;
-using railproof::mb::wayside::PointsConfig;
-using railproof::messages::PositionReport;
-using railproof::mb::wayside::RegisterStatus;
-using railproof::mb::wayside::ReportStatus;
-using railproof::mb::wayside::RouteConfig;
-using railproof::core::Section;
+using namespace railproof::core;  // NOLINT(google-build-using-namespace)
+using namespace railproof::mb::wayside;  // NOLINT(google-build-using-namespace)
+using namespace railproof::messages;  // NOLINT(google-build-using-namespace)
 
 constexpr std::int64_t kBlocks = 10'000;
 constexpr std::int64_t kBlockMm = 50'000;

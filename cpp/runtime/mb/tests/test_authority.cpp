@@ -2,7 +2,7 @@
 // supervision and speed-restriction store, at millisecond / millimetre resolution.
 //
 // Kills the seeded faults FAULT_MB_ACCEPT_NOT_NEWER and FAULT_MB_VALIDITY_FROM_RECEPTION
-// (build this file against a faulty railproof_onboard).
+// (the unit_fault_<F> ctest entries run these tests against the schemata variant).
 #include <gtest/gtest.h>
 
 #include <array>

@@ -6,7 +6,7 @@
 //
 // Kills the seeded faults FAULT_MB_NO_TRAIN_MARGIN, FAULT_MB_ABNORMAL_RELEASED,
 // FAULT_MB_LOCK_IGNORES_AUTHORITY, FAULT_MB_TIMEOUT_INCLUSIVE, FAULT_MB_POSSESSION_NO_CONFIRM,
-// FAULT_MB_OCCUPANCY_NO_CORRECTION (build this file against a faulty railproof_wayside).
+// FAULT_MB_OCCUPANCY_NO_CORRECTION (the unit_fault_<F> ctest entries run these tests against the schemata variant).
 #include <gtest/gtest.h>
 
 #include <cstddef>

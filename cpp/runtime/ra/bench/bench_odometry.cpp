@@ -20,12 +20,7 @@
 
 namespace {
 
-using railproof::ra::CycleInput;
-using railproof::ra::Method;
-using railproof::ra::Mode;
-using railproof::ra::Odometry;
-using railproof::ra::OdometryConfig;
-using railproof::ra::OdometrySection;
+using namespace railproof::ra;  // NOLINT(google-build-using-namespace)
 
 constexpr double kPulseM = 3.14159265358979323846 * 0.86 / 90.0;
 

@@ -8,7 +8,7 @@
 // Seeded faults (negative tests, cpp/runtime/ra/tests/test_odometry.cpp kills each):
 //   FAULT_RA_NO_GRAVITY_COMPENSATION   A_x = a_x (the G sin(theta) term left out)
 //   FAULT_RA_NO_CANT_CORRECTION        omega_y'' without the yaw-in-cant term omega_z sin(Psi)
-// Never defined in the railproof_odometry library.
+// Active only in the test-only schemata variant (spec/design/seeded-faults.md).
 #include <algorithm>
 #include <cmath>
 #include <cstdint>

@@ -3,11 +3,12 @@
 //
 // Seeded fault (negative test, cpp/runtime/ra/tests/test_odometry.cpp kills it):
 //   FAULT_RA_NO_GRADIENT_TERM   Delta_a without the gradient term Delta_a_g
-// Never defined in the railproof_odometry library.
+// Active only in the test-only schemata variant (spec/design/seeded-faults.md).
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
 
+#include "railproof/core/enum_names.hpp"
 #include "railproof/core/seeded_fault.hpp"
 #include "railproof/generated/ra_params.hpp"
 #include "railproof/ra/odometry.hpp"
@@ -73,38 +74,11 @@ std::int64_t ReportCorrectionMm(const OdometryOutput& o) noexcept {
 }
 
 const char* ToString(InputError e) noexcept {
-  switch (e) {
-    case InputError::kNone: return "none";
-    case InputError::kCycleTimeGap: return "cycle time not one cycle after the previous (gap or non-monotonic)";
-    case InputError::kTgPulsesDecreasing: return "TG pulse count decreasing";
-    case InputError::kTgEdgeInvalid: return "TG edge or sample time invalid";
-    case InputError::kTgImplausibleRate: return "TG pulse rate above the maximum speed";
-    case InputError::kImuSampleCount: return "IMU sample count not imu_samples_per_cycle";
-    case InputError::kImuTimestamps: return "IMU timestamps not spaced imu_sample_ms within the cycle";
-    case InputError::kImuNotFinite: return "IMU value not finite";
-    case InputError::kImuOutOfRange: return "IMU value out of range";
-  }
-  return "unknown";
+  return core::EnumName(e, std::array<const char*, 9>{"none", "cycle time not one cycle after the previous (gap or non-monotonic)", "TG pulse count decreasing", "TG edge or sample time invalid", "TG pulse rate above the maximum speed", "IMU sample count not imu_samples_per_cycle", "IMU timestamps not spaced imu_sample_ms within the cycle", "IMU value not finite", "IMU value out of range"}, "unknown");
 }
 
 const char* ToString(ConfigError e) noexcept {
-  switch (e) {
-    case ConfigError::kNone: return "none";
-    case ConfigError::kWheelDiameter: return "wheel diameter not in 500..1500 mm";
-    case ConfigError::kTrainLength: return "train length not in 1..1000 m";
-    case ConfigError::kThreshold: return "detection threshold not in 50..2000 mm/s^2";
-    case ConfigError::kStartPoints: return "start points not 1..2";
-    case ConfigError::kRateError: return "IMU rate error negative or above 1 deg/s";
-    case ConfigError::kSectionCount: return "section count 0, above the capacity, or no section array";
-    case ConfigError::kSectionOrder: return "sections not ordered and contiguous (begin >= end, overlap or gap)";
-    case ConfigError::kSectionGradient: return "section gradient negative or above 100 permille";
-    case ConfigError::kSectionTime: return "section maximum compensation time outside [min, limit] or not whole cycles";
-    case ConfigError::kSectionMargin: return "section margin below the error model";
-    case ConfigError::kAccelBounds: return "baseline acceleration bounds not positive";
-    case ConfigError::kInitialOutside: return "initial front outside the section table";
-    case ConfigError::kLengthCorrection: return "length correction not in 0..100000 ppm";
-  }
-  return "unknown";
+  return core::EnumName(e, std::array<const char*, 14>{"none", "wheel diameter not in 500..1500 mm", "train length not in 1..1000 m", "detection threshold not in 50..2000 mm/s^2", "start points not 1..2", "IMU rate error negative or above 1 deg/s", "section count 0, above the capacity, or no section array", "sections not ordered and contiguous (begin >= end, overlap or gap)", "section gradient negative or above 100 permille", "section maximum compensation time outside [min, limit] or not whole cycles", "section margin below the error model", "baseline acceleration bounds not positive", "initial front outside the section table", "length correction not in 0..100000 ppm"}, "unknown");
 }
 
 }  // namespace railproof::ra

@@ -13,7 +13,7 @@
 // Seeded faults (negative tests, cpp/runtime/ra/tests/test_odometry.cpp kills each):
 //   FAULT_RA_WINDOW_SPEED_ONLY     the TG speed always from the 1 s pulse count
 //   FAULT_RA_NO_PERMANENT_MARGIN   the margin is added to the envelope only while compensating
-// Never defined in the railproof_odometry library.
+// Active only in the test-only schemata variant (spec/design/seeded-faults.md).
 #include "railproof/core/seeded_fault.hpp"
 #include "railproof/ra/odometry.hpp"
 

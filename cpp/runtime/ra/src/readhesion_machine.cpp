@@ -1,8 +1,8 @@
 // Re-adhesion state machine (spec/design/ra.md §5). The numbered steps are those of
 // the design note and of cycle() in models/ra.pml.
 //
-// Seeded faults (negative tests, one per build of railproof_odometry_fault_<name>; the
-// conformance replay of the readhesion vectors must fail against each):
+// Seeded faults (negative tests, active only in the test-only schemata variant,
+// spec/design/seeded-faults.md; the conformance replay of the ra vectors must fail against each):
 //   FAULT_RA_TIMEOUT_OFF_BY_ONE    a candidate times out only at age > t_max + 1
 //   FAULT_RA_CONFIRM_TWO           re-adhesion adopted after two confirming cycles
 //   FAULT_RA_SPEED_IGNORED         the speed condition of the judgement is ignored

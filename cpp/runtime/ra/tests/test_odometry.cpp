@@ -8,8 +8,7 @@
 //
 // Kills the seeded faults FAULT_RA_NO_GRADIENT_TERM, FAULT_RA_WINDOW_SPEED_ONLY,
 // FAULT_RA_NO_PERMANENT_MARGIN, FAULT_RA_NO_GRAVITY_COMPENSATION and
-// FAULT_RA_NO_CANT_CORRECTION (build this file against the odometry sources compiled with
-// the macro).
+// FAULT_RA_NO_CANT_CORRECTION (ctest unit_fault_<F>: these tests against the schemata variant with the fault selected).
 #include <gtest/gtest.h>
 
 #include <algorithm>

@@ -67,6 +67,26 @@ struct Kinematics {
 // Synthetic stream: integrates the train and the wheel in 1 ms steps, counts TG pulses
 // (pulse length pi * 0.86 m / 90) and records each pulse edge time (linear interpolation
 // within the ms, rounded to the us, strictly increasing).
+// A hand-made cycle: TG values as given, IMU level and at rest unless changed.
+inline CycleInput Cycle(std::int64_t time_ms, std::int64_t pulses, std::int64_t edge_us, const ImuValues& m = {}) {
+  CycleInput in;
+  in.time_ms = time_ms;
+  in.tg.time_us = time_ms * 1000;
+  in.tg.pulses = pulses;
+  in.tg.last_edge_us = edge_us;
+  for (int j = 0; j < kImuSamplesPerCycle; ++j) {
+    ImuSample& s = in.imu[static_cast<std::size_t>(j)];
+    s.time_us = time_ms * 1000 - (9 - j) * 10'000;
+    s.ax = m.ax;
+    s.ay = m.ay;
+    s.az = m.az;
+    s.wx = m.wx;
+    s.wy = m.wy;
+    s.wz = m.wz;
+  }
+  return in;
+}
+
 class Stream {
  public:
   explicit Stream(double v0 = 0.0, std::int64_t t0_ms = 1'000) : v_(v0), time_ms_(t0_ms) {}
@@ -102,21 +122,7 @@ class Stream {
       x_first_ = x_;
       pulses_first_ = pulses_;
     }
-    CycleInput in;
-    in.time_ms = time_ms_;
-    in.tg.time_us = time_ms_ * 1000;
-    in.tg.pulses = pulses_;
-    in.tg.last_edge_us = edge_us_;
-    for (int j = 0; j < kImuSamplesPerCycle; ++j) {
-      ImuSample& s = in.imu[static_cast<std::size_t>(j)];
-      s.time_us = time_ms_ * 1000 - (9 - j) * 10'000;
-      s.ax = m.ax;
-      s.ay = m.ay;
-      s.az = m.az;
-      s.wx = m.wx;
-      s.wy = m.wy;
-      s.wz = m.wz;
-    }
+    CycleInput in = Cycle(time_ms_, pulses_, edge_us_, m);
     in.imu_count = static_cast<std::uint8_t>(kImuSamplesPerCycle);
     if (balise_mm) in.balise = BaliseFix{*balise_mm};
     return in;
@@ -141,25 +147,6 @@ class Stream {
   std::int64_t time_ms_ = 0;
 };
 
-// A hand-made cycle: TG values as given, IMU level and at rest unless changed.
-inline CycleInput Cycle(std::int64_t time_ms, std::int64_t pulses, std::int64_t edge_us, const ImuValues& m = {}) {
-  CycleInput in;
-  in.time_ms = time_ms;
-  in.tg.time_us = time_ms * 1000;
-  in.tg.pulses = pulses;
-  in.tg.last_edge_us = edge_us;
-  for (int j = 0; j < kImuSamplesPerCycle; ++j) {
-    ImuSample& s = in.imu[static_cast<std::size_t>(j)];
-    s.time_us = time_ms * 1000 - (9 - j) * 10'000;
-    s.ax = m.ax;
-    s.ay = m.ay;
-    s.az = m.az;
-    s.wx = m.wx;
-    s.wy = m.wy;
-    s.wz = m.wz;
-  }
-  return in;
-}
 
 // v[k] with an int index.
 template <typename T>

@@ -11,12 +11,12 @@
 //
 // Kills the seeded faults FAULT_RA_TIMEOUT_OFF_BY_ONE, FAULT_RA_CONFIRM_TWO,
 // FAULT_RA_SPEED_IGNORED, FAULT_RA_EPISODE_RELAXES, FAULT_RA_LAST_CANDIDATE_WINS,
-// FAULT_RA_TG_FAILURE_IGNORED (build this file against readhesion_machine.cpp compiled with
-// the macro).
+// FAULT_RA_TG_FAILURE_IGNORED (ctest unit_fault_<F>: these tests against the schemata variant with the fault selected).
 #include <gtest/gtest.h>
 
 #include <cstdint>
 
+#include "railproof/testing/enum_names.hpp"
 #include "railproof/testing/alloc_counter.hpp"
 #include "railproof/generated/ra_params.hpp"
 #include "railproof/ra/readhesion_machine.hpp"
@@ -113,15 +113,8 @@ TEST(OdometryReadhesionMachine, ConfigurationValidation) {
 // @verifies REQ-RA-007
 // @verifies REQ-RA-013
 TEST(OdometryReadhesionMachine, NamesOfTheVectors) {
-  EXPECT_STREQ(ToString(Mode::kTg), "TG");
-  EXPECT_STREQ(ToString(Mode::kCompensating), "COMPENSATING");
-  EXPECT_STREQ(ToString(Mode::kStopped), "STOPPED");
-  EXPECT_STREQ(ToString(static_cast<Mode>(9)), "INVALID");
-  EXPECT_STREQ(ToString(StopReason::kNone), "NONE");
-  EXPECT_STREQ(ToString(StopReason::kMaxCompensationTime), "MAX_COMPENSATION_TIME");
-  EXPECT_STREQ(ToString(StopReason::kImuFailure), "IMU_FAILURE");
-  EXPECT_STREQ(ToString(StopReason::kTgFailure), "TG_FAILURE");
-  EXPECT_STREQ(ToString(static_cast<StopReason>(9)), "INVALID");
+  railproof::testing::ExpectEnumNames<Mode>(std::array<const char*, 3>{"TG", "COMPENSATING", "STOPPED"});
+  railproof::testing::ExpectEnumNames<StopReason>(std::array<const char*, 4>{"NONE", "MAX_COMPENSATION_TIME", "IMU_FAILURE", "TG_FAILURE"});
 }
 
 // Steps 1 and 4: a fresh machine is in TG odometry with a valid position; the first cycle

@@ -17,14 +17,7 @@
 
 namespace {
 
-using railproof::tg::EncodedFrame;
-using railproof::tg::Endpoint;
-using railproof::tg::EndpointConfig;
-using railproof::tg::kBlockBytes;
-using railproof::tg::kPayloadMax;
-using railproof::tg::LinkKey;
-using railproof::tg::RejectReason;
-using railproof::tg::Role;
+using namespace railproof::tg;  // NOLINT(google-build-using-namespace)
 
 constexpr std::uint16_t kGroundId = 1;
 constexpr std::uint16_t kTrainId = 42;

@@ -1,5 +1,5 @@
 // Generator of the committed seed corpus of fuzz_frame_decode
-// (cpp/tests/fuzz/corpus/frame_decode/): every catalogue telegram of fuzz_common.hpp as a
+// (cpp/runtime/tg/fuzz/corpus/frame_decode/): every catalogue telegram of fuzz_common.hpp as a
 // valid frame, plus one seed per rejection path of checks 1-3 and 5 (design §4).
 //
 //   fuzz_make_corpus --out DIR        write the corpus files into DIR

@@ -3,9 +3,8 @@
 // Receive = receive(). Checks 1-3 are DecodeFrame's (frame.cpp); checks 4-8 below, each a
 // named function, in the order of design §4.
 //
-// Seeded faults (negative tests, cpp/tests/conformance/CMakeLists.txt): each FAULT_* macro
-// below, when defined, injects exactly one fault; the conformance vectors must detect each.
-// They are never defined in the railproof_radio library.
+// Seeded faults RAILPROOF_FAULT(FAULT_TG_*) (spec/design/seeded-faults.md): active only in the
+// test-only schemata variant; the conformance vectors and the unit tests must detect each.
 #include "railproof/core/seeded_fault.hpp"
 #include "railproof/tg/endpoint.hpp"
 

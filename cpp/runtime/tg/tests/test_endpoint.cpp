@@ -21,7 +21,7 @@
 #include "railproof/tg/telegram.hpp"
 #include "railproof/testing/alloc_counter.hpp"
 
-// Allocation counter (REQ-TG-018: no heap per telegram): cpp/tests/unit/alloc_counter.cpp.
+// Allocation counter (REQ-TG-018: no heap per telegram): cpp/testing/src/alloc_counter.cpp.
 
 namespace railproof::tg {
 namespace {

@@ -18,11 +18,7 @@
 
 namespace {
 
-using railproof::tg::ReedSolomon;
-using railproof::tg::Rs6650;
-using railproof::tg::RsDecodeResult;
-using railproof::tg::RsParams;
-using railproof::tg::RsStatus;
+using namespace railproof::tg;  // NOLINT(google-build-using-namespace)
 using Bytes = std::vector<std::uint8_t>;
 
 namespace tg = railproof::params::tg;

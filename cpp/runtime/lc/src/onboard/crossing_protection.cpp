@@ -1,6 +1,6 @@
 // Level-crossing protection, on-board part (spec/design/lc.md §1-§3).
-// Seeded faults (negative tests; the model mirrors them as mutants) are compiled in only with
-// their FAULT_LC_* macro:
+// Seeded faults (negative tests; the model mirrors them as mutants), active only in the
+// test-only schemata variant (spec/design/seeded-faults.md):
 //   FAULT_LC_CLEAR_WITHOUT_WARNING_TIME  clearance ignores ws + warning_time <= now + ETA
 //   FAULT_LC_STALE_CONFIRMATION          the age of a CLOSED confirmation is not checked
 //   FAULT_LC_WITHDRAW_AT_FRONT           withdrawal when the front (front_max) passed far

@@ -1,9 +1,9 @@
 // Centre scheduler of the GNSS-time pre-armed crossings (spec/design/lc.md §5).
-// Seeded fault (negative test; the model mirrors it as a mutant), compiled in only with its
-// macro:
+// Seeded fault (negative test; the model mirrors it as a mutant), active only in the test-only
+// schemata variant (spec/design/seeded-faults.md):
 //   FAULT_LC_DEPART_WITHOUT_ALL_ACKS  the departure is cleared with one acknowledgement missing
 //
-// The earliest arrival is lc::EarliestArrivalMs (railproof_onboard): the centre and the
+// The earliest arrival is lc::EarliestArrivalMs (the common part railproof_lc_common): the centre and the
 // train predict with the same function.
 #include "railproof/core/seeded_fault.hpp"
 #include "railproof/lc/wayside/centre_scheduler.hpp"

@@ -1,6 +1,6 @@
 // Level-crossing controller (spec/design/lc.md §4, §5 step 2, clock rule).
-// Seeded faults (negative tests; the model mirrors them as mutants) are compiled in only with
-// their FAULT_LC_* macro:
+// Seeded faults (negative tests; the model mirrors them as mutants), active only in the
+// test-only schemata variant (spec/design/seeded-faults.md):
 //   FAULT_LC_END_WITH_REQUESTER          a withdrawal removes every requester (the warning
 //                                        ends when one of two requesters withdrew)
 //   FAULT_LC_LATER_UPDATE_WHILE_WARNING  a later start time is stored although the warning

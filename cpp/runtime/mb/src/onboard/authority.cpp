@@ -2,8 +2,8 @@
 // (spec/design/mb.md §4). AuthorityReceiver::Receive mirrors receive() of
 // models/mb.pml: the same checks in the same order.
 //
-// Seeded faults (negative tests): FAULT_MB_ACCEPT_NOT_NEWER, FAULT_MB_VALIDITY_FROM_RECEPTION
-// inject one fault each; never defined in the railproof_onboard library.
+// Seeded faults (negative tests): FAULT_MB_ACCEPT_NOT_NEWER, FAULT_MB_VALIDITY_FROM_RECEPTION,
+// active only in the test-only schemata variant (spec/design/seeded-faults.md).
 #include "railproof/core/seeded_fault.hpp"
 #include "railproof/mb/onboard/authority.hpp"
 

@@ -23,6 +23,7 @@
 #include <optional>
 #include <span>
 
+#include "railproof/core/enum_names.hpp"
 #include "railproof/br/supervisor.hpp"
 #include "railproof/generated/br_params.hpp"
 #include "railproof/core/fixed_vector.hpp"
@@ -94,11 +95,7 @@ using core::PositionEstimate;  // railproof/core/track.hpp
 enum class Pattern : std::uint8_t { kEmergency, kService };
 
 constexpr const char* ToString(Pattern p) noexcept {
-  switch (p) {
-    case Pattern::kEmergency: return "EMERGENCY";
-    case Pattern::kService: return "SERVICE";
-  }
-  return "INVALID";
+  return core::EnumName(p, std::array<const char*, 2>{"EMERGENCY", "SERVICE"});
 }
 
 // Train data / parameter errors of Create, reported in this order (REQ-BR-008, REQ-BR-010).
@@ -123,24 +120,7 @@ enum class CreateError : std::uint8_t {
 };
 
 constexpr const char* ToString(CreateError e) noexcept {
-  switch (e) {
-    case CreateError::kNone: return "NONE";
-    case CreateError::kTrainLengthInvalid: return "TRAIN_LENGTH_INVALID";
-    case CreateError::kAccelerationInvalid: return "ACCELERATION_INVALID";
-    case CreateError::kDecelerationInvalid: return "DECELERATION_INVALID";
-    case CreateError::kServiceAboveEmergency: return "SERVICE_ABOVE_EMERGENCY";
-    case CreateError::kFreeRunningInvalid: return "FREE_RUNNING_INVALID";
-    case CreateError::kSpeedAllowanceInvalid: return "SPEED_ALLOWANCE_INVALID";
-    case CreateError::kTimeInvalid: return "TIME_INVALID";
-    case CreateError::kServiceOffsetInvalid: return "SERVICE_OFFSET_INVALID";
-    case CreateError::kLeadsInvalid: return "LEADS_INVALID";
-    case CreateError::kGradientErrorInvalid: return "GRADIENT_ERROR_INVALID";
-    case CreateError::kGravityInvalid: return "GRAVITY_INVALID";
-    case CreateError::kMaxSpeedInvalid: return "MAX_SPEED_INVALID";
-    case CreateError::kCapacityInvalid: return "CAPACITY_INVALID";
-    case CreateError::kOutOfMemory: return "OUT_OF_MEMORY";
-  }
-  return "INVALID";
+  return core::EnumName(e, std::array<const char*, 15>{"NONE", "TRAIN_LENGTH_INVALID", "ACCELERATION_INVALID", "DECELERATION_INVALID", "SERVICE_ABOVE_EMERGENCY", "FREE_RUNNING_INVALID", "SPEED_ALLOWANCE_INVALID", "TIME_INVALID", "SERVICE_OFFSET_INVALID", "LEADS_INVALID", "GRADIENT_ERROR_INVALID", "GRAVITY_INVALID", "MAX_SPEED_INVALID", "CAPACITY_INVALID", "OUT_OF_MEMORY"});
 }
 
 // Profile verdicts of SetProfile (REQ-BR-008, REQ-BR-005). Checked in this order: the two
@@ -163,19 +143,7 @@ enum class ProfileVerdict : std::uint8_t {
 };
 
 constexpr const char* ToString(ProfileVerdict v) noexcept {
-  switch (v) {
-    case ProfileVerdict::kAccept: return "ACCEPT";
-    case ProfileVerdict::kTooManyGradients: return "TOO_MANY_GRADIENTS";
-    case ProfileVerdict::kTooManyRestrictions: return "TOO_MANY_RESTRICTIONS";
-    case ProfileVerdict::kPositionOutOfRange: return "POSITION_OUT_OF_RANGE";
-    case ProfileVerdict::kEmptySegment: return "EMPTY_SEGMENT";
-    case ProfileVerdict::kUnsorted: return "UNSORTED";
-    case ProfileVerdict::kOverlap: return "OVERLAP";
-    case ProfileVerdict::kGradientOutOfRange: return "GRADIENT_OUT_OF_RANGE";
-    case ProfileVerdict::kLimitOutOfRange: return "LIMIT_OUT_OF_RANGE";
-    case ProfileVerdict::kBrakingNotPositive: return "BRAKING_NOT_POSITIVE";
-  }
-  return "INVALID";
+  return core::EnumName(v, std::array<const char*, 10>{"ACCEPT", "TOO_MANY_GRADIENTS", "TOO_MANY_RESTRICTIONS", "POSITION_OUT_OF_RANGE", "EMPTY_SEGMENT", "UNSORTED", "OVERLAP", "GRADIENT_OUT_OF_RANGE", "LIMIT_OUT_OF_RANGE", "BRAKING_NOT_POSITIVE"});
 }
 
 struct ProfileResult {
@@ -196,14 +164,7 @@ enum class EvalStatus : std::uint8_t {
 };
 
 constexpr const char* ToString(EvalStatus s) noexcept {
-  switch (s) {
-    case EvalStatus::kOk: return "OK";
-    case EvalStatus::kNoProfile: return "NO_PROFILE";
-    case EvalStatus::kInvalidPosition: return "INVALID_POSITION";
-    case EvalStatus::kInvalidSpeed: return "INVALID_SPEED";
-    case EvalStatus::kInvalidStopLimit: return "INVALID_STOP_LIMIT";
-  }
-  return "INVALID";
+  return core::EnumName(s, std::array<const char*, 5>{"OK", "NO_PROFILE", "INVALID_POSITION", "INVALID_SPEED", "INVALID_STOP_LIMIT"});
 }
 
 struct Evaluation {

@@ -49,6 +49,8 @@
 // loops, typed results, deterministic. Units: Hz, counts, ms, km/h (check-speed codes).
 #pragma once
 
+#include "railproof/core/enum_names.hpp"
+
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -88,18 +90,7 @@ enum class SpeedCheckConfigError : std::uint8_t {
 };
 
 constexpr const char* ToString(SpeedCheckConfigError e) noexcept {
-  switch (e) {
-    case SpeedCheckConfigError::kNone: return "None";
-    case SpeedCheckConfigError::kOscillatorInvalid: return "OscillatorInvalid";
-    case SpeedCheckConfigError::kThresholdInvalid: return "ThresholdInvalid";
-    case SpeedCheckConfigError::kTableEmpty: return "TableEmpty";
-    case SpeedCheckConfigError::kTableTooLarge: return "TableTooLarge";
-    case SpeedCheckConfigError::kCheckSpeedInvalid: return "CheckSpeedInvalid";
-    case SpeedCheckConfigError::kN2eInvalid: return "N2eInvalid";
-    case SpeedCheckConfigError::kGateTimeoutInvalid: return "GateTimeoutInvalid";
-    case SpeedCheckConfigError::kOscillatorTimeoutInvalid: return "OscillatorTimeoutInvalid";
-  }
-  return "Invalid";
+  return core::EnumName(e, std::array<const char*, 9>{"None", "OscillatorInvalid", "ThresholdInvalid", "TableEmpty", "TableTooLarge", "CheckSpeedInvalid", "N2eInvalid", "GateTimeoutInvalid", "OscillatorTimeoutInvalid"}, "Invalid");
 }
 
 // Why the check brakes (or kRelease). When several hold, the first in this order of
@@ -117,16 +108,7 @@ enum class SpeedCheckReason : std::uint8_t {
 };
 
 constexpr const char* ToString(SpeedCheckReason r) noexcept {
-  switch (r) {
-    case SpeedCheckReason::kRelease: return "RELEASE";
-    case SpeedCheckReason::kOverspeed: return "OVERSPEED";
-    case SpeedCheckReason::kNoDecision: return "NO_DECISION";
-    case SpeedCheckReason::kUnknownCheckSpeed: return "UNKNOWN_CHECK_SPEED";
-    case SpeedCheckReason::kGateTimeout: return "GATE_TIMEOUT";
-    case SpeedCheckReason::kOscillatorStopped: return "OSCILLATOR_STOPPED";
-    case SpeedCheckReason::kClockFault: return "CLOCK_FAULT";
-  }
-  return "INVALID";
+  return core::EnumName(r, std::array<const char*, 7>{"RELEASE", "OVERSPEED", "NO_DECISION", "UNKNOWN_CHECK_SPEED", "GATE_TIMEOUT", "OSCILLATOR_STOPPED", "CLOCK_FAULT"});
 }
 
 struct SpeedCheckOutput {
@@ -150,12 +132,7 @@ enum class SelectVerdict : std::uint8_t {
 };
 
 constexpr const char* ToString(SelectVerdict v) noexcept {
-  switch (v) {
-    case SelectVerdict::kSelected: return "SELECTED";
-    case SelectVerdict::kUnchanged: return "UNCHANGED";
-    case SelectVerdict::kUnknownCheckSpeed: return "UNKNOWN_CHECK_SPEED";
-  }
-  return "INVALID";
+  return core::EnumName(v, std::array<const char*, 3>{"SELECTED", "UNCHANGED", "UNKNOWN_CHECK_SPEED"});
 }
 
 struct SpeedCheckCreateResult;

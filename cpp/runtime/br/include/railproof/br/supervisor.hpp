@@ -7,6 +7,8 @@
 // Runtime module: no heap, no exceptions, no recursion, deterministic. Units: mm/s.
 #pragma once
 
+#include "railproof/core/enum_names.hpp"
+
 #include <cstdint>
 
 namespace railproof::br {
@@ -15,15 +17,7 @@ namespace railproof::br {
 enum class BrakeLevel : std::uint8_t { kNone, k4N, k5N, k6N, k7N, kEmergency };
 
 constexpr const char* ToString(BrakeLevel l) noexcept {
-  switch (l) {
-    case BrakeLevel::kNone: return "NONE";
-    case BrakeLevel::k4N: return "4N";
-    case BrakeLevel::k5N: return "5N";
-    case BrakeLevel::k6N: return "6N";
-    case BrakeLevel::k7N: return "7N";
-    case BrakeLevel::kEmergency: return "EB";
-  }
-  return "INVALID";
+  return core::EnumName(l, std::array<const char*, 6>{"NONE", "4N", "5N", "6N", "7N", "EB"});
 }
 
 // A pattern speed of kNoPermittedSpeed means that not even standing is permitted at that

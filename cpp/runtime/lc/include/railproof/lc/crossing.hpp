@@ -15,6 +15,7 @@
 #include <limits>
 #include <span>
 
+#include "railproof/core/enum_names.hpp"
 #include "railproof/core/track.hpp"
 #include "railproof/core/units.hpp"
 #include "railproof/generated/lc_params.hpp"
@@ -94,16 +95,7 @@ enum class CrossingDataError : std::uint8_t {
 };
 
 constexpr const char* ToString(CrossingDataError e) noexcept {
-  switch (e) {
-    case CrossingDataError::kNone: return "NONE";
-    case CrossingDataError::kExtentInvalid: return "EXTENT_INVALID";
-    case CrossingDataError::kWarningTimeInvalid: return "WARNING_TIME_INVALID";
-    case CrossingDataError::kDuplicateId: return "DUPLICATE_ID";
-    case CrossingDataError::kUnsorted: return "UNSORTED";
-    case CrossingDataError::kOverlap: return "OVERLAP";
-    case CrossingDataError::kTooMany: return "TOO_MANY";
-  }
-  return "INVALID";
+  return core::EnumName(e, std::array<const char*, 7>{"NONE", "EXTENT_INVALID", "WARNING_TIME_INVALID", "DUPLICATE_ID", "UNSORTED", "OVERLAP", "TOO_MANY"});
 }
 
 struct CrossingDataCheck {
@@ -135,15 +127,7 @@ enum class EtaError : std::uint8_t {
 };
 
 constexpr const char* ToString(EtaError e) noexcept {
-  switch (e) {
-    case EtaError::kNone: return "NONE";
-    case EtaError::kPositionInvalid: return "POSITION_INVALID";
-    case EtaError::kSpeedInvalid: return "SPEED_INVALID";
-    case EtaError::kAccelerationInvalid: return "ACCELERATION_INVALID";
-    case EtaError::kProfileInvalid: return "PROFILE_INVALID";
-    case EtaError::kTimeInvalid: return "TIME_INVALID";
-  }
-  return "INVALID";
+  return core::EnumName(e, std::array<const char*, 6>{"NONE", "POSITION_INVALID", "SPEED_INVALID", "ACCELERATION_INVALID", "PROFILE_INVALID", "TIME_INVALID"});
 }
 
 struct EtaResult {

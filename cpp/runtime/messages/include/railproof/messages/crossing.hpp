@@ -3,6 +3,8 @@
 // side (lc::wayside::CrossingController, lc::wayside::CentreScheduler) meet here.
 #pragma once
 
+#include "railproof/core/enum_names.hpp"
+
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -18,13 +20,7 @@ namespace railproof::messages {
 enum class CrossingStatus : std::uint8_t { kOpen, kWarning, kClosed, kFailed };
 
 constexpr const char* ToString(CrossingStatus s) noexcept {
-  switch (s) {
-    case CrossingStatus::kOpen: return "OPEN";
-    case CrossingStatus::kWarning: return "WARNING";
-    case CrossingStatus::kClosed: return "CLOSED";
-    case CrossingStatus::kFailed: return "FAILED";
-  }
-  return "INVALID";
+  return core::EnumName(s, std::array<const char*, 4>{"OPEN", "WARNING", "CLOSED", "FAILED"});
 }
 
 // Crossing report (the controller's cycle output, broadcast to trains and the centre).

@@ -8,6 +8,8 @@
 // [begin_mm, end_mm).
 #pragma once
 
+#include "railproof/core/enum_names.hpp"
+
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -29,18 +31,7 @@ enum class Obstruction : std::uint8_t {
 };
 
 constexpr const char* ToString(Obstruction kind) noexcept {
-  switch (kind) {
-    case Obstruction::kNone: return "NONE";
-    case Obstruction::kPrecedingTrain: return "PRECEDING_TRAIN";
-    case Obstruction::kFixedBlock: return "FIXED_BLOCK";
-    case Obstruction::kRouteEnd: return "ROUTE_END";
-    case Obstruction::kHandover: return "HANDOVER";
-    case Obstruction::kSystemBoundary: return "SYSTEM_BOUNDARY";
-    case Obstruction::kPossession: return "POSSESSION";
-    case Obstruction::kAbnormalTrain: return "ABNORMAL_TRAIN";
-    case Obstruction::kEndOfTrack: return "END_OF_TRACK";
-  }
-  return "INVALID";
+  return core::EnumName(kind, std::array<const char*, 9>{"NONE", "PRECEDING_TRAIN", "FIXED_BLOCK", "ROUTE_END", "HANDOVER", "SYSTEM_BOUNDARY", "POSSESSION", "ABNORMAL_TRAIN", "END_OF_TRACK"});
 }
 
 // A temporary speed restriction (REQ-MB-015): kilometre range [begin_mm, end_mm) and the

@@ -10,6 +10,8 @@
 // the conformance vectors of the model replay exactly (times in cycles, margins in mm).
 #pragma once
 
+#include "railproof/core/enum_names.hpp"
+
 #include <array>
 #include <cstdint>
 
@@ -23,21 +25,10 @@ enum class Mode : std::uint8_t { kTg, kCompensating, kStopped };
 enum class StopReason : std::uint8_t { kNone, kMaxCompensationTime, kImuFailure, kTgFailure };
 
 constexpr const char* ToString(Mode m) noexcept {
-  switch (m) {
-    case Mode::kTg: return "TG";
-    case Mode::kCompensating: return "COMPENSATING";
-    case Mode::kStopped: return "STOPPED";
-  }
-  return "INVALID";
+  return core::EnumName(m, std::array<const char*, 3>{"TG", "COMPENSATING", "STOPPED"});
 }
 constexpr const char* ToString(StopReason r) noexcept {
-  switch (r) {
-    case StopReason::kNone: return "NONE";
-    case StopReason::kMaxCompensationTime: return "MAX_COMPENSATION_TIME";
-    case StopReason::kImuFailure: return "IMU_FAILURE";
-    case StopReason::kTgFailure: return "TG_FAILURE";
-  }
-  return "INVALID";
+  return core::EnumName(r, std::array<const char*, 4>{"NONE", "MAX_COMPENSATION_TIME", "IMU_FAILURE", "TG_FAILURE"});
 }
 
 // Limits of the odometry sections under the train this cycle (design note §6): the
@@ -96,15 +87,7 @@ enum class MachineError : std::uint8_t {
 };
 
 constexpr const char* ToString(MachineError e) noexcept {
-  switch (e) {
-    case MachineError::kNone: return "none";
-    case MachineError::kConfirmCyclesInvalid: return "confirm_cycles not in 1..100";
-    case MachineError::kStartPointsInvalid: return "start_points not in 1..2";
-    case MachineError::kSpacingInvalid: return "spacing_cycles not in 1..10000";
-    case MachineError::kSectionInvalid: return "section limits invalid (time < 1 cycle or margin < 0)";
-    case MachineError::kStartAgeInvalid: return "start-point age negative";
-  }
-  return "unknown";
+  return core::EnumName(e, std::array<const char*, 6>{"none", "confirm_cycles not in 1..100", "start_points not in 1..2", "spacing_cycles not in 1..10000", "section limits invalid (time < 1 cycle or margin < 0)", "start-point age negative"}, "unknown");
 }
 
 class ReadhesionMachine {

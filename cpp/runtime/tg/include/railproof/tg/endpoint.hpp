@@ -17,6 +17,7 @@
 #include <cstdint>
 #include <span>
 
+#include "railproof/core/enum_names.hpp"
 #include "railproof/generated/tg_params.hpp"
 #include "railproof/tg/aead.hpp"
 #include "railproof/tg/frame.hpp"
@@ -83,47 +84,19 @@ enum class SendStatus : std::uint8_t {
 };
 
 constexpr const char* ToString(Role role) noexcept {
-  switch (role) {
-    case Role::kGround: return "ground";
-    case Role::kTrain: return "train";
-  }
-  return "invalid";
+  return core::EnumName(role, std::array<const char*, 2>{"ground", "train"}, "invalid");
 }
 
 constexpr const char* ToString(LinkState link) noexcept {
-  switch (link) {
-    case LinkState::kNone: return "NONE";
-    case LinkState::kUp: return "UP";
-    case LinkState::kLost: return "LOST";
-  }
-  return "INVALID";
+  return core::EnumName(link, std::array<const char*, 3>{"NONE", "UP", "LOST"});
 }
 
 constexpr const char* ToString(ConfigError error) noexcept {
-  switch (error) {
-    case ConfigError::kNone: return "None";
-    case ConfigError::kInvalidRole: return "InvalidRole";
-    case ConfigError::kSameIds: return "SameIds";
-    case ConfigError::kSeqModulusOutOfRange: return "SeqModulusOutOfRange";
-    case ConfigError::kSeqWindowOutOfRange: return "SeqWindowOutOfRange";
-    case ConfigError::kHistoryDepthOutOfRange: return "HistoryDepthOutOfRange";
-    case ConfigError::kInitialSeqOutOfRange: return "InitialSeqOutOfRange";
-    case ConfigError::kTurnaroundOutOfRange: return "TurnaroundOutOfRange";
-    case ConfigError::kLinkTimeoutOutOfRange: return "LinkTimeoutOutOfRange";
-    case ConfigError::kEchoValidityOutOfRange: return "EchoValidityOutOfRange";
-    case ConfigError::kCryptoUnavailable: return "CryptoUnavailable";
-  }
-  return "Invalid";
+  return core::EnumName(error, std::array<const char*, 11>{"None", "InvalidRole", "SameIds", "SeqModulusOutOfRange", "SeqWindowOutOfRange", "HistoryDepthOutOfRange", "InitialSeqOutOfRange", "TurnaroundOutOfRange", "LinkTimeoutOutOfRange", "EchoValidityOutOfRange", "CryptoUnavailable"}, "Invalid");
 }
 
 constexpr const char* ToString(SendStatus status) noexcept {
-  switch (status) {
-    case SendStatus::kSent: return "Sent";
-    case SendStatus::kPayloadTooLong: return "PayloadTooLong";
-    case SendStatus::kNotInitialised: return "NotInitialised";
-    case SendStatus::kEncodeFailed: return "EncodeFailed";
-  }
-  return "Invalid";
+  return core::EnumName(status, std::array<const char*, 4>{"Sent", "PayloadTooLong", "NotInitialised", "EncodeFailed"}, "Invalid");
 }
 
 // Type a role sends, and the type it expects from its peer (design §2).

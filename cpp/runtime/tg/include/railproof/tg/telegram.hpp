@@ -7,6 +7,7 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "railproof/core/enum_names.hpp"
 #include "railproof/generated/tg_params.hpp"
 
 namespace railproof::tg {
@@ -108,21 +109,7 @@ enum class RejectReason : std::uint8_t {
 // Stable names (the rejection column of design §4); "Invalid" for out-of-range values.
 // @implements REQ-TG-018
 constexpr const char* ToString(RejectReason reason) noexcept {
-  switch (reason) {
-    case RejectReason::kNone: return "None";
-    case RejectReason::kBadLength: return "BadLength";
-    case RejectReason::kRsUncorrectable: return "RsUncorrectable";
-    case RejectReason::kBadFormat: return "BadFormat";
-    case RejectReason::kCrcMismatch: return "CrcMismatch";
-    case RejectReason::kWrongAddress: return "WrongAddress";
-    case RejectReason::kAuthFailed: return "AuthFailed";
-    case RejectReason::kRepeated: return "Repeated";
-    case RejectReason::kOutOfSequence: return "OutOfSequence";
-    case RejectReason::kNoEcho: return "NoEcho";
-    case RejectReason::kUnknownEcho: return "UnknownEcho";
-    case RejectReason::kStale: return "Stale";
-  }
-  return "Invalid";
+  return core::EnumName(reason, std::array<const char*, 12>{"None", "BadLength", "RsUncorrectable", "BadFormat", "CrcMismatch", "WrongAddress", "AuthFailed", "Repeated", "OutOfSequence", "NoEcho", "UnknownEcho", "Stale"}, "Invalid");
 }
 
 }  // namespace railproof::tg

@@ -45,15 +45,9 @@ namespace railproof::lc::analysis {
 // the shared offline pieces (line and train data, JSON, plots, command line)
 using namespace ::railproof::offline;  // NOLINT(google-build-using-namespace)
 
-inline constexpr std::string_view kTimetableSchema = "railproof/timetable/1";
-
-// ---- YAML subset ---------------------------------------------------------------------------
-// The timetable is YAML; the C++ build has no YAML library, so the study reads the subset the
-// timetable format uses: block mappings and block sequences by indentation (spaces), flow
-// mappings {k: v} and flow sequences [a, b] (also over several lines), plain, single- and
-// double-quoted scalars, comments. Plain scalars: true/false, null/~, integers, decimals,
-// anything else a string. Errors: InputError "<file>:<line>: <reason>".
-nlohmann::json ParseYamlSubset(std::string_view text, const std::string& file);
+// The timetable JSON that railproof_testgen timetables writes from spec/timetables/<name>.yaml
+// (build/gen/timetables/<name>.json: validated against spec/, times in ms, a dwell per stop).
+inline constexpr std::string_view kTimetableSchema = "railproof/timetable-json/1";
 
 // ---- timetable -------------------------------------------------------------------------------
 
@@ -113,18 +107,19 @@ struct Timetable {
   std::vector<Service> services;
 };
 
-// "HH:MM" or "HH:MM:SS" -> ms after midnight (nullopt if malformed; hours 0..47).
-std::optional<std::int64_t> ParseClockTime(std::string_view text);
 // ms after midnight -> "HH:MM:SS".
 std::string FormatClockTime(std::int64_t ms);
 
-// Parses the timetable (schema, types, ranges); `file` names it in messages.
+// Reads the timetable JSON (kTimetableSchema): types, and every value within the range the
+// study's arithmetic is made for; the rest of the format is the validator's (spec/design/data.md).
+// `file` names it in messages: InputError "<file>: <entry>: <reason>".
 Timetable ParseTimetable(std::string_view text, const std::string& file);
 Timetable LoadTimetable(const std::filesystem::path& path);
 
-// Checks the timetable against the line and the train types: line name, running lines,
-// stations (on the running line, in running order, no repeats, origin before destination),
-// train types known, train not longer than a platform it stops at, dwell >= min dwell.
+// Checks that the timetable fits the line and the train types the study is given (which need
+// not be those the validator saw): line name, train types known, running lines, stations (on
+// the running line, origin before destination, stops strictly between them in running
+// order), the train on every platform it starts, stops or ends at.
 // Throws InputError "<file>: services[i] (<id>)...: <reason>".
 void CheckTimetable(const Timetable& tt, const offline::Line& line, const std::map<std::string, TrainType>& trains);
 

@@ -33,6 +33,7 @@
 #include <optional>
 #include <span>
 
+#include "railproof/core/enum_names.hpp"
 #include "railproof/core/track.hpp"
 #include "railproof/core/units.hpp"
 #include "railproof/lc/crossing.hpp"
@@ -53,14 +54,7 @@ using messages::WithdrawalAck;
 enum class CrossingState : std::uint8_t { kApproaching, kRequested, kCleared, kPassed, kDone };
 
 constexpr const char* ToString(CrossingState s) noexcept {
-  switch (s) {
-    case CrossingState::kApproaching: return "APPROACHING";
-    case CrossingState::kRequested: return "REQUESTED";
-    case CrossingState::kCleared: return "CLEARED";
-    case CrossingState::kPassed: return "PASSED";
-    case CrossingState::kDone: return "DONE";
-  }
-  return "INVALID";
+  return core::EnumName(s, std::array<const char*, 5>{"APPROACHING", "REQUESTED", "CLEARED", "PASSED", "DONE"});
 }
 
 // Train and parameters. Defaults from spec/parameters/level_crossing.yaml.
@@ -104,26 +98,7 @@ enum class ProtectionError : std::uint8_t {
 };
 
 constexpr const char* ToString(ProtectionError e) noexcept {
-  switch (e) {
-    case ProtectionError::kNone: return "NONE";
-    case ProtectionError::kTrainLengthInvalid: return "TRAIN_LENGTH_INVALID";
-    case ProtectionError::kAccelerationInvalid: return "ACCELERATION_INVALID";
-    case ProtectionError::kParameterInvalid: return "PARAMETER_INVALID";
-    case ProtectionError::kCrossingExtentInvalid: return "CROSSING_EXTENT_INVALID";
-    case ProtectionError::kCrossingWarningTimeInvalid: return "CROSSING_WARNING_TIME_INVALID";
-    case ProtectionError::kCrossingDuplicateId: return "CROSSING_DUPLICATE_ID";
-    case ProtectionError::kCrossingUnsorted: return "CROSSING_UNSORTED";
-    case ProtectionError::kCrossingOverlap: return "CROSSING_OVERLAP";
-    case ProtectionError::kTooManyCrossings: return "TOO_MANY_CROSSINGS";
-    case ProtectionError::kTimeWentBack: return "TIME_WENT_BACK";
-    case ProtectionError::kTimeInvalid: return "TIME_INVALID";
-    case ProtectionError::kPositionInvalid: return "POSITION_INVALID";
-    case ProtectionError::kSpeedInvalid: return "SPEED_INVALID";
-    case ProtectionError::kDwellWhileMoving: return "DWELL_WHILE_MOVING";
-    case ProtectionError::kProfileInvalid: return "PROFILE_INVALID";
-    case ProtectionError::kTooManyMessages: return "TOO_MANY_MESSAGES";
-  }
-  return "INVALID";
+  return core::EnumName(e, std::array<const char*, 17>{"NONE", "TRAIN_LENGTH_INVALID", "ACCELERATION_INVALID", "PARAMETER_INVALID", "CROSSING_EXTENT_INVALID", "CROSSING_WARNING_TIME_INVALID", "CROSSING_DUPLICATE_ID", "CROSSING_UNSORTED", "CROSSING_OVERLAP", "TOO_MANY_CROSSINGS", "TIME_WENT_BACK", "TIME_INVALID", "POSITION_INVALID", "SPEED_INVALID", "DWELL_WHILE_MOVING", "PROFILE_INVALID", "TOO_MANY_MESSAGES"});
 }
 
 // Most reports and most acknowledgements accepted per cycle (each).

@@ -26,6 +26,7 @@
 #include <optional>
 #include <span>
 
+#include "railproof/core/enum_names.hpp"
 #include "railproof/core/track.hpp"
 #include "railproof/core/units.hpp"
 #include "railproof/generated/lc_params.hpp"
@@ -74,14 +75,7 @@ enum class DepartureBlock : std::uint8_t {
 };
 
 constexpr const char* ToString(DepartureBlock b) noexcept {
-  switch (b) {
-    case DepartureBlock::kNone: return "NONE";
-    case DepartureBlock::kNoDeparture: return "NO_DEPARTURE";
-    case DepartureBlock::kMissingAck: return "MISSING_ACK";
-    case DepartureBlock::kClockFault: return "CLOCK_FAULT";
-    case DepartureBlock::kBeforeDeparture: return "BEFORE_DEPARTURE";
-  }
-  return "INVALID";
+  return core::EnumName(b, std::array<const char*, 5>{"NONE", "NO_DEPARTURE", "MISSING_ACK", "CLOCK_FAULT", "BEFORE_DEPARTURE"});
 }
 
 // Errors of Create / StartDeparture / Cycle.
@@ -100,19 +94,7 @@ enum class SchedulerError : std::uint8_t {
 };
 
 constexpr const char* ToString(SchedulerError e) noexcept {
-  switch (e) {
-    case SchedulerError::kNone: return "NONE";
-    case SchedulerError::kConfigInvalid: return "CONFIG_INVALID";
-    case SchedulerError::kCrossingDataInvalid: return "CROSSING_DATA_INVALID";
-    case SchedulerError::kPositionInvalid: return "POSITION_INVALID";
-    case SchedulerError::kSpeedInvalid: return "SPEED_INVALID";
-    case SchedulerError::kProfileInvalid: return "PROFILE_INVALID";
-    case SchedulerError::kTimeInvalid: return "TIME_INVALID";
-    case SchedulerError::kTimeWentBack: return "TIME_WENT_BACK";
-    case SchedulerError::kNoDeparture: return "NO_DEPARTURE";
-    case SchedulerError::kTooManyMessages: return "TOO_MANY_MESSAGES";
-  }
-  return "INVALID";
+  return core::EnumName(e, std::array<const char*, 10>{"NONE", "CONFIG_INVALID", "CROSSING_DATA_INVALID", "POSITION_INVALID", "SPEED_INVALID", "PROFILE_INVALID", "TIME_INVALID", "TIME_WENT_BACK", "NO_DEPARTURE", "TOO_MANY_MESSAGES"});
 }
 
 // One centre cycle's inputs.

@@ -24,6 +24,7 @@
 #include <optional>
 #include <span>
 
+#include "railproof/core/enum_names.hpp"
 #include "railproof/generated/lc_params.hpp"
 #include "railproof/lc/crossing.hpp"
 #include "railproof/messages/crossing.hpp"
@@ -43,15 +44,7 @@ inline constexpr std::size_t kMaxControllerMessages = 32;
 enum class ControllerState : std::uint8_t { kOpen, kWarning, kClosing, kClosed, kOpening, kFailed };
 
 constexpr const char* ToString(ControllerState s) noexcept {
-  switch (s) {
-    case ControllerState::kOpen: return "OPEN";
-    case ControllerState::kWarning: return "WARNING";
-    case ControllerState::kClosing: return "CLOSING";
-    case ControllerState::kClosed: return "CLOSED";
-    case ControllerState::kOpening: return "OPENING";
-    case ControllerState::kFailed: return "FAILED";
-  }
-  return "INVALID";
+  return core::EnumName(s, std::array<const char*, 6>{"OPEN", "WARNING", "CLOSING", "CLOSED", "OPENING", "FAILED"});
 }
 
 // What the clock hardware tells this cycle (REQ-LC-013):
@@ -61,12 +54,7 @@ constexpr const char* ToString(ControllerState s) noexcept {
 enum class ClockInput : std::uint8_t { kGnss, kNoGnss, kFault };
 
 constexpr const char* ToString(ClockInput c) noexcept {
-  switch (c) {
-    case ClockInput::kGnss: return "GNSS";
-    case ClockInput::kNoGnss: return "NO_GNSS";
-    case ClockInput::kFault: return "FAULT";
-  }
-  return "INVALID";
+  return core::EnumName(c, std::array<const char*, 3>{"GNSS", "NO_GNSS", "FAULT"});
 }
 
 // Clock state of the controller (REQ-LC-013). kFaulty is latched until MaintenanceReset
@@ -75,12 +63,7 @@ constexpr const char* ToString(ClockInput c) noexcept {
 enum class ClockState : std::uint8_t { kSynchronised, kHoldover, kFaulty };
 
 constexpr const char* ToString(ClockState c) noexcept {
-  switch (c) {
-    case ClockState::kSynchronised: return "SYNCHRONISED";
-    case ClockState::kHoldover: return "HOLDOVER";
-    case ClockState::kFaulty: return "FAULTY";
-  }
-  return "INVALID";
+  return core::EnumName(c, std::array<const char*, 3>{"SYNCHRONISED", "HOLDOVER", "FAULTY"});
 }
 
 // Why the controller is kFailed.
@@ -93,13 +76,7 @@ enum class FailureReason : std::uint8_t {
 };
 
 constexpr const char* ToString(FailureReason r) noexcept {
-  switch (r) {
-    case FailureReason::kNone: return "NONE";
-    case FailureReason::kBarrierNotDown: return "BARRIER_NOT_DOWN";
-    case FailureReason::kBarrierDownLost: return "BARRIER_DOWN_LOST";
-    case FailureReason::kBarrierNotUp: return "BARRIER_NOT_UP";
-  }
-  return "INVALID";
+  return core::EnumName(r, std::array<const char*, 4>{"NONE", "BARRIER_NOT_DOWN", "BARRIER_DOWN_LOST", "BARRIER_NOT_UP"});
 }
 
 // Parameters (spec/parameters/lc.yaml).
@@ -252,14 +229,7 @@ enum class ControllerError : std::uint8_t {
 };
 
 constexpr const char* ToString(ControllerError e) noexcept {
-  switch (e) {
-    case ControllerError::kNone: return "NONE";
-    case ControllerError::kConfigInvalid: return "CONFIG_INVALID";
-    case ControllerError::kTimeWentBack: return "TIME_WENT_BACK";
-    case ControllerError::kTimeInvalid: return "TIME_INVALID";
-    case ControllerError::kTooManyMessages: return "TOO_MANY_MESSAGES";
-  }
-  return "INVALID";
+  return core::EnumName(e, std::array<const char*, 5>{"NONE", "CONFIG_INVALID", "TIME_WENT_BACK", "TIME_INVALID", "TOO_MANY_MESSAGES"});
 }
 
 struct CrossingControllerResult;

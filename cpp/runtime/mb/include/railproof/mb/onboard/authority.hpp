@@ -17,6 +17,7 @@
 #include <optional>
 #include <span>
 
+#include "railproof/core/enum_names.hpp"
 #include "railproof/core/track.hpp"
 #include "railproof/messages/stop_limit.hpp"
 
@@ -53,13 +54,7 @@ enum class Verdict : std::uint8_t {
 };
 
 constexpr const char* ToString(Verdict v) noexcept {
-  switch (v) {
-    case Verdict::kAccept: return "ACCEPT";
-    case Verdict::kTooOld: return "TOO_OLD";
-    case Verdict::kNotNewer: return "NOT_NEWER";
-    case Verdict::kFutureIssue: return "FUTURE_ISSUE";
-  }
-  return "INVALID";
+  return core::EnumName(v, std::array<const char*, 4>{"ACCEPT", "TOO_OLD", "NOT_NEWER", "FUTURE_ISSUE"});
 }
 
 // @implements REQ-MB-009
@@ -105,12 +100,7 @@ enum class SetBackVerdict : std::uint8_t {
 };
 
 constexpr const char* ToString(SetBackVerdict v) noexcept {
-  switch (v) {
-    case SetBackVerdict::kOk: return "Ok";
-    case SetBackVerdict::kOutsideSection: return "OutsideSection";
-    case SetBackVerdict::kTooFar: return "TooFar";
-  }
-  return "Invalid";
+  return core::EnumName(v, std::array<const char*, 3>{"Ok", "OutsideSection", "TooFar"}, "Invalid");
 }
 
 enum class SetBackConfigError : std::uint8_t {

@@ -36,6 +36,7 @@
 #include <optional>
 #include <span>
 
+#include "railproof/core/enum_names.hpp"
 #include "railproof/core/fixed_vector.hpp"
 #include "railproof/core/track.hpp"
 #include "railproof/messages/position_report.hpp"
@@ -192,40 +193,7 @@ enum class ConfigError : std::uint8_t {
 };
 
 constexpr const char* ToString(ConfigError e) noexcept {
-  switch (e) {
-    case ConfigError::kNone: return "None";
-    case ConfigError::kLineLengthInvalid: return "LineLengthInvalid";
-    case ConfigError::kTooFewBlocks: return "TooFewBlocks";
-    case ConfigError::kTooManyBlocks: return "TooManyBlocks";
-    case ConfigError::kBlocksNotFromZero: return "BlocksNotFromZero";
-    case ConfigError::kBlocksNotIncreasing: return "BlocksNotIncreasing";
-    case ConfigError::kBlocksNotToLineEnd: return "BlocksNotToLineEnd";
-    case ConfigError::kTooManySections: return "TooManySections";
-    case ConfigError::kFixedBlockInvalid: return "FixedBlockInvalid";
-    case ConfigError::kSetBackSectionInvalid: return "SetBackSectionInvalid";
-    case ConfigError::kNoStopSectionInvalid: return "NoStopSectionInvalid";
-    case ConfigError::kTooManyPoints: return "TooManyPoints";
-    case ConfigError::kPointsIdDuplicate: return "PointsIdDuplicate";
-    case ConfigError::kPointsSectionInvalid: return "PointsSectionInvalid";
-    case ConfigError::kPointsNotOnBlockBoundaries: return "PointsNotOnBlockBoundaries";
-    case ConfigError::kTooManyRoutes: return "TooManyRoutes";
-    case ConfigError::kRouteIdDuplicate: return "RouteIdDuplicate";
-    case ConfigError::kRouteInvalid: return "RouteInvalid";
-    case ConfigError::kRouteUnknownPoints: return "RouteUnknownPoints";
-    case ConfigError::kTooManyHandovers: return "TooManyHandovers";
-    case ConfigError::kHandoverIdDuplicate: return "HandoverIdDuplicate";
-    case ConfigError::kHandoverInvalid: return "HandoverInvalid";
-    case ConfigError::kSystemBoundaryInvalid: return "SystemBoundaryInvalid";
-    case ConfigError::kMarginInvalid: return "MarginInvalid";
-    case ConfigError::kPolicyInvalid: return "PolicyInvalid";
-    case ConfigError::kD2ParamsInvalid: return "D2ParamsInvalid";
-    case ConfigError::kTimeInvalid: return "TimeInvalid";
-    case ConfigError::kSetBackMaxInvalid: return "SetBackMaxInvalid";
-    case ConfigError::kCapacityInvalid: return "CapacityInvalid";
-    case ConfigError::kHistoryTooSmall: return "HistoryTooSmall";
-    case ConfigError::kOutOfMemory: return "OutOfMemory";
-  }
-  return "Invalid";
+  return core::EnumName(e, std::array<const char*, 31>{"None", "LineLengthInvalid", "TooFewBlocks", "TooManyBlocks", "BlocksNotFromZero", "BlocksNotIncreasing", "BlocksNotToLineEnd", "TooManySections", "FixedBlockInvalid", "SetBackSectionInvalid", "NoStopSectionInvalid", "TooManyPoints", "PointsIdDuplicate", "PointsSectionInvalid", "PointsNotOnBlockBoundaries", "TooManyRoutes", "RouteIdDuplicate", "RouteInvalid", "RouteUnknownPoints", "TooManyHandovers", "HandoverIdDuplicate", "HandoverInvalid", "SystemBoundaryInvalid", "MarginInvalid", "PolicyInvalid", "D2ParamsInvalid", "TimeInvalid", "SetBackMaxInvalid", "CapacityInvalid", "HistoryTooSmall", "OutOfMemory"}, "Invalid");
 }
 
 // ---- trains and reports ---------------------------------------------------------------
@@ -285,20 +253,7 @@ enum class ReportStatus : std::uint8_t {
 };
 
 constexpr const char* ToString(ReportStatus s) noexcept {
-  switch (s) {
-    case ReportStatus::kAccepted: return "Accepted";
-    case ReportStatus::kUnknownTrain: return "UnknownTrain";
-    case ReportStatus::kBlockOutOfRange: return "BlockOutOfRange";
-    case ReportStatus::kOffsetOutOfBlock: return "OffsetOutOfBlock";
-    case ReportStatus::kLengthMismatch: return "LengthMismatch";
-    case ReportStatus::kCorrectionOutOfRange: return "CorrectionOutOfRange";
-    case ReportStatus::kBaliseOffLine: return "BaliseOffLine";
-    case ReportStatus::kSpeedOutOfRange: return "SpeedOutOfRange";
-    case ReportStatus::kWrongDirection: return "WrongDirection";
-    case ReportStatus::kBackwardMovement: return "BackwardMovement";
-    case ReportStatus::kSetBackTooFar: return "SetBackTooFar";
-  }
-  return "Invalid";
+  return core::EnumName(s, std::array<const char*, 11>{"Accepted", "UnknownTrain", "BlockOutOfRange", "OffsetOutOfBlock", "LengthMismatch", "CorrectionOutOfRange", "BaliseOffLine", "SpeedOutOfRange", "WrongDirection", "BackwardMovement", "SetBackTooFar"}, "Invalid");
 }
 
 // Front as block + offset (canonical: the block holding position front_mm - 1; block 0,
@@ -324,19 +279,7 @@ enum class CommandStatus : std::uint8_t {
 };
 
 constexpr const char* ToString(CommandStatus s) noexcept {
-  switch (s) {
-    case CommandStatus::kAccepted: return "Accepted";
-    case CommandStatus::kUnknownTrain: return "UnknownTrain";
-    case CommandStatus::kUnknownRoute: return "UnknownRoute";
-    case CommandStatus::kUnknownHandover: return "UnknownHandover";
-    case CommandStatus::kUnknownId: return "UnknownId";
-    case CommandStatus::kInvalidRange: return "InvalidRange";
-    case CommandStatus::kCapacityExceeded: return "CapacityExceeded";
-    case CommandStatus::kRefusedInUse: return "RefusedInUse";
-    case CommandStatus::kNotConfirmable: return "NotConfirmable";
-    case CommandStatus::kNoSystemBoundary: return "NoSystemBoundary";
-  }
-  return "Invalid";
+  return core::EnumName(s, std::array<const char*, 10>{"Accepted", "UnknownTrain", "UnknownRoute", "UnknownHandover", "UnknownId", "InvalidRange", "CapacityExceeded", "RefusedInUse", "NotConfirmable", "NoSystemBoundary"}, "Invalid");
 }
 
 // Status and the id the ground assigned (ids count up from 1; 0 on failure).
@@ -353,12 +296,7 @@ enum class PossessionState : std::uint8_t {
 };
 
 constexpr const char* ToString(PossessionState s) noexcept {
-  switch (s) {
-    case PossessionState::kNone: return "NONE";
-    case PossessionState::kRequested: return "REQUESTED";
-    case PossessionState::kActive: return "ACTIVE";
-  }
-  return "INVALID";
+  return core::EnumName(s, std::array<const char*, 3>{"NONE", "REQUESTED", "ACTIVE"});
 }
 
 enum class CycleStatus : std::uint8_t {

@@ -1,0 +1,61 @@
+// Private to the ground unit's sources (cpp/runtime/mb/src/wayside/ground*.cpp): constants
+// and allocation-free helpers shared by the sections of the ground cycle.
+#pragma once
+
+#include <algorithm>
+#include <cstdint>
+#include <limits>
+#include <span>
+
+#include "railproof/mb/wayside/ground.hpp"
+
+namespace railproof::mb::wayside::ground_detail {
+
+constexpr std::uint32_t kNoSlot = std::numeric_limits<std::uint32_t>::max();
+constexpr std::int64_t kPlusInf = std::numeric_limits<std::int64_t>::max();
+constexpr std::int64_t kMinusInf = std::numeric_limits<std::int64_t>::min();
+constexpr std::int64_t kPpm = 1'000'000;
+constexpr std::int64_t kMsPerS = 1'000;
+
+// ceil(a / b) for a >= 0, b > 0.
+constexpr std::int64_t CeilDiv(std::int64_t a, std::int64_t b) noexcept { return (a + b - 1) / b; }
+
+// In-place, non-recursive, allocation-free sort (heap sort).
+template <typename T, typename Less>
+void HeapSort(std::span<T> v, Less less) noexcept {
+  std::make_heap(v.begin(), v.end(), less);
+  std::sort_heap(v.begin(), v.end(), less);
+}
+
+inline bool ValidSectionList(std::span<const Section> list, std::int64_t length_mm, std::size_t& entry) noexcept {
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    const Section& s = list[i];
+    const bool bad = s.begin_mm < 0 || s.end_mm > length_mm || s.begin_mm >= s.end_mm ||
+                     (i > 0 && s.begin_mm < list[i - 1].end_mm);
+    if (bad) {
+      entry = i;
+      return false;
+    }
+  }
+  return true;
+}
+
+template <typename T>
+bool CopyInto(FixedVector<T>& dst, std::span<const T> src, std::size_t capacity) noexcept {
+  if (!dst.Allocate(capacity)) {
+    return false;  // GCOVR_EXCL_LINE defensive: out of memory
+  }
+  for (const T& x : src) {
+    if (!dst.PushBack(x)) {
+      return false;  // GCOVR_EXCL_LINE unreachable: capacity >= src.size() checked
+    }
+  }
+  return true;
+}
+
+template <typename T>
+bool AllocateFull(FixedVector<T>& v, std::size_t n) noexcept {
+  return v.Allocate(n) && v.Resize(n);
+}
+
+}  // namespace railproof::mb::wayside::ground_detail
