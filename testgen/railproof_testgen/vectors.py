@@ -98,6 +98,7 @@ class Part(ABC):
     walk_defines = ("WALK",)          # -D symbols of a random walk
     walk_steps = None                 # a walk's length in SPIN statements (spin -u), if the model
     #                                   does not end it itself
+    walk_events = None                # the model bound giving a walk's number of events (None: any, >= 1)
 
     def configuration(self, define) -> Configuration:
         for c in self.configurations:
@@ -129,7 +130,7 @@ class Part(ABC):
     # the common rules, overridden where a capability has its own
     def walk_length(self, bounds: dict, define) -> int | None:
         """The number of events a random walk must give (None: at least one)."""
-        return None
+        return bounds[self.walk_events] if self.walk_events else None
 
     def vector_id(self, kind: str, define, tail: str) -> str:
         """tail: the goal (G<k>) or the seed (S<seed>)."""

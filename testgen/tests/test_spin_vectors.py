@@ -247,6 +247,7 @@ class Counters(vectors.Part):
                       Configuration("FAST", suffix=".fast", tag="FAST-", walks=4, walk_evidence=True))
     variant_search = "unreachable"
     walk_defines = ()
+    walk_events = "steps"
 
     def bounds(self, model, params_pml):
         return vectors.model_bounds(params_pml, ("limit", "wide_limit", "steps"))
@@ -271,9 +272,6 @@ class Counters(vectors.Part):
         """Every run shows the counting (REQ-TG-001), b catching up with a REQ-TG-003."""
         caught_up = any(s["out"]["a"] == s["out"]["b"] > 0 for s in steps)
         return {"REQ-TG-001"} | ({"REQ-TG-003"} if caught_up else set())
-
-    def walk_length(self, bounds, define):
-        return bounds["steps"]
 
     def header(self, target, define):
         b = target.bounds
@@ -366,7 +364,7 @@ def test_random_walks_per_configuration(generated):
                                        "CT-RANDOM-S1", "CT-RANDOM-S2", "CT-RANDOM-S3"]
     walks = [v for v in main if v["kind"] == "random"]
     assert [v["seed"] for v in walks] == [1, 2, 3] and all(v["goal"] is None for v in walks)
-    assert all(len(v["steps"]) == 8 for v in walks)  # Part.walk_length: MODEL_STEPS
+    assert all(len(v["steps"]) == 8 for v in walks)  # Part.walk_events: MODEL_STEPS
     assert len({json.dumps(v["steps"]) for v in walks}) > 1  # the seeds give different runs
     fast = [v for v in files["counters.fast.jsonl"][1:] if v["kind"] == "random"]
     assert [v["id"] for v in fast] == ["CT-RANDOM-FAST-S1"]  # walks // 4, at least one

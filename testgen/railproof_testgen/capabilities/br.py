@@ -33,6 +33,7 @@ _RX_OUT = re.compile(r"@OUT level=(\d) appr=([01]) latched=([01])")
 class Braking(Part):
     prefix = "BR"
     configurations = (Configuration(None, walks=1),)
+    walk_events = "cycles"
 
     def bounds(self, model, params_pml):
         return model_bounds(params_pml, ("vmax", "cycles"))
@@ -81,9 +82,6 @@ class Braking(Part):
             if s["out"]["pattern_approaching"]:
                 reqs.add("REQ-BR-003")
         return reqs
-
-    def walk_length(self, bounds, define):
-        return bounds["cycles"]
 
     def header(self, target, define):
         b = target.bounds

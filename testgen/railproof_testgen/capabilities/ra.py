@@ -50,6 +50,7 @@ class ReAdhesion(Part):
     prefix = "RA"
     configurations = (Configuration(None, walks=1),
                       Configuration("ONE_START", suffix=".one_start", tag="ONESTART-", walks=5))
+    walk_events = "cycles"
 
     def bounds(self, model, params_pml):
         return model_bounds(params_pml, BOUNDS)
@@ -121,9 +122,6 @@ class ReAdhesion(Part):
             if o["balise_reset"]:
                 reqs.add("REQ-RA-012")
         return reqs
-
-    def walk_length(self, bounds, define):
-        return bounds["cycles"]
 
     def header(self, target, define):
         b = target.bounds
