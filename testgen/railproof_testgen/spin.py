@@ -395,6 +395,9 @@ def search_goals(model: Path, params_dir: Path, workdir: Path, defines, numbers,
     numbers = list(numbers)
     if not numbers:
         raise PipelineError(f"{model.name} [{' '.join(defines)}]: a trap search needs goals")
+    if f'#include "{goals_file(model)}"' not in model.read_text(encoding="utf-8"):
+        raise SpecError(model, "TRAPS", f'the model does not #include "{goals_file(model)}" (its goal flags g[K] '
+                                        f'are searched with the trap claim and C code of that file)')
     if pan_flags is None:
         pan_flags = parse_annotations(model).pan_flags
     wd = prepare(model, params_dir, workdir, defines, cflags=[*pan_flags, f'-DPROV="{_FILTER_INSTALL}"'],

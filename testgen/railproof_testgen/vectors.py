@@ -80,6 +80,7 @@ class Configuration:
         return self.define or "default"
 
     def walk_count(self, walks: int) -> int:
+        """The number of random walks in this configuration for --walks `walks`."""
         if self.walks <= 0:
             return 0
         return walks if self.walks == 1 else max(1, walks // self.walks)
@@ -291,6 +292,9 @@ class Generation:
         if walk_steps is not None and part.walk_steps is None:
             raise SpecError(self.model, "--walk-steps", f"the model ends its random walks itself (capability "
                                                         f"{capability}: no walk length in SPIN statements)")
+        if part.variant_search not in ("all", "unreachable"):
+            raise SpecError(f"capabilities/{capability}.py", "variant_search",
+                            f"{part.variant_search!r} is neither 'all' nor 'unreachable'")
         ann = spin_mod.parse_annotations(self.model)
         if not ann.goals:
             raise SpecError(self.model, "-", "no // @goal annotations: nothing to generate")

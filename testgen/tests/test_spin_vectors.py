@@ -226,6 +226,13 @@ def test_a_model_assertion_in_the_trap_search_is_an_error(tmp_path):
         spin.search_goals(COUNTERS, _params(tmp_path), tmp_path / "search", ["TRAPS", "BROKEN"], [0, 1, 2])
 
 
+def test_a_model_without_the_goals_include_is_named(tmp_path):
+    model = tmp_path / "counters.pml"
+    model.write_text(COUNTERS.read_text().replace('#include "counters_goals.pml"', ""))
+    with pytest.raises(SpecError, match=r'counters.pml: TRAPS: the model does not #include "counters_goals.pml"'):
+        spin.search_goals(model, _params(tmp_path), tmp_path / "search", ["TRAPS"], [0])
+
+
 def test_an_incomplete_search_does_not_make_goals_unreachable(tmp_path, monkeypatch):
     monkeypatch.setattr(spin, "prepare", lambda *a, **k: tmp_path)
     out = ("error: max search depth too small\nFull statespace search for:\n"
