@@ -16,8 +16,9 @@ set(_tg ${RAILPROOF_SOURCE_DIR}/testgen/railproof_testgen)
 # modules it runs (the command line imports only the module of the command)
 set(_tg_base ${_tg}/__init__.py ${_tg}/__main__.py ${_tg}/errors.py)
 set(_tg_spin ${_tg_base} ${_tg}/spin.py)
-file(GLOB _tg_engine CONFIGURE_DEPENDS ${_tg}/vectorgen.py ${_tg}/vectors.py)
-list(APPEND _tg_engine ${_tg}/spec.py ${_tg}/registry.py ${_tg}/capabilities/__init__.py)
+# the vector engine and what it finds a model's capability part with (the registry)
+set(_tg_engine ${_tg}/vectors.py ${_tg}/spec.py ${_tg}/registry.py ${_tg}/capabilities/__init__.py
+    ${RAILPROOF_SOURCE_DIR}/spec/capabilities.yaml ${RAILPROOF_SOURCE_DIR}/spec/schemas/capabilities.schema.json)
 
 # SPIN and vector generation are memory- and CPU-heavy: at most two at a time (each runs its
 # own searches on two worker threads).

@@ -1,372 +1,253 @@
-"""Derive conformance vectors from a SPIN model.
+"""Derive conformance vectors from a SPIN model: the generic engine.
 
-Three kinds of vectors (spec/design/tg.md §7, schema spec/schemas/vectors_tg.schema.json):
-- trap: every `// @goal K` becomes a trap property `[] !g[K]`; pan (BFS) returns the
-  shortest run that reaches the goal, whose replayed @IN/@OUT lines are the vector.
-  Goals whose label names a boundary, edge or wrap-around are the boundary vectors.
-- random: seeded random walks (`spin -n<seed> -u<steps>`); the seed is in the id.
-Each run of the model is emitted once per endpoint role (ground, train): the logic is
-the same, the identifiers, telegram types and safe-reaction output differ.
-A goal that the exhaustive search cannot reach must be justified in spec/justifications.
+``railproof_testgen vectors --model models/<m>.pml --params DIR --spec spec --work DIR --out DIR``
+
+Every model's vectors are made the same way (conventions §1, the design notes spec/design/<cap>.md);
+what differs lives in the capability's part, testgen/railproof_testgen/capabilities/<cap>.py,
+found through the capability registry (spec/capabilities.yaml): its configuration table, the
+parser of the model's @IN/@OUT output, the conversion to the vector step format, the
+requirements a run shows, the header, the vector ids and any rule of its own (class Part).
+
+- Trap vectors. Every `// @goal K` is a trap property "goal flag g[K] is never set", searched in
+  the configuration its annotation names (`[config X]`, -DX; none: the model's default
+  configuration). The goals of one configuration are searched together, by one breadth-first
+  search that keeps each goal's first violation (spin.search_goals: the same shortest run as
+  the goal's own trap property); the run, replayed with `spin -t`, is the goal's vector. A
+  goal whose label contains one of the part's boundary words gives a boundary vector.
+- Variants. The goals of the default configuration are searched again in each `// @variant`
+  of the model: all of them (Part.variant_search = "all") or those the default configuration
+  cannot reach ("unreachable"); a goal reached there gives a vector in the variant's file.
+- Random walks: seeded simulations (`spin -n<seed>`) in the configurations the part's table
+  gives walks to; the seed is in the id.
+- Goal coverage (<model>.coverage.json): every goal reached with its vectors, or unreachable
+  (the search is complete) with the justification spec/justifications/<cap>.yaml gives it
+  (states searched recorded). An unreachable goal without one, or a justification of a goal
+  that is reached or unknown, fails the command (after the files are written, so that the
+  coverage shows the problem).
+- Files: one JSON Lines file per file suffix of the configuration table, <model><suffix>.jsonl
+  (a header, then the vectors), each line checked against spec/schemas/vectors_<cap>.schema.json
+  before anything is written; every file written atomically; files of configurations no
+  longer generated are removed.
 """
 from __future__ import annotations
 
+import importlib
 import json
+from abc import ABC, abstractmethod
 import os
 import re
-import shutil
 from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass
+from functools import cached_property
 from pathlib import Path
 
 import jsonschema
 
 from . import __version__
+from . import registry as registry_mod
 from . import spin as spin_mod
 from .errors import PipelineError, SpecError
 from .spec import load_yaml
 
-VERDICTS = ["ACCEPT", "REJ_INTEGRITY", "REJ_ADDRESS", "REJ_AUTH", "REJ_REPEATED", "REJ_SEQUENCE",
-            "REJ_NO_ECHO", "REJ_UNKNOWN_ECHO", "REJ_STALE"]
-LINKS = ["NONE", "UP", "LOST"]
-NONE = 255
-# delivery modes of the model (D_INTACT ... D_MISADDR)
-MODE_INTACT, MODE_DUP, MODE_CORRUPT, MODE_FORGE, MODE_MISADDR = range(5)
-
-# requirement evidenced by observing a verdict / transition in a run
-VERDICT_REQS = {
-    "ACCEPT": ["REQ-TG-008"], "REJ_INTEGRITY": ["REQ-TG-005"], "REJ_ADDRESS": ["REQ-TG-003"],
-    "REJ_AUTH": ["REQ-TG-007"], "REJ_REPEATED": ["REQ-TG-001"], "REJ_SEQUENCE": ["REQ-TG-004"],
-    "REJ_NO_ECHO": ["REQ-TG-012"], "REJ_UNKNOWN_ECHO": ["REQ-TG-008"],
-    "REJ_STALE": ["REQ-TG-006", "REQ-TG-009"],
-}
-LOST_REQS = ["REQ-TG-013", "REQ-TG-014", "REQ-TG-015"]
-BOUNDARY_WORDS = ("boundary", "edge", "wrap")
-
-_IN_TICK = re.compile(r"@IN tick")
-_IN_RX = re.compile(r"@IN rx seq=(\d+) echo=(\d+) mode=(\d+)")
-_OUT_TX = re.compile(r"@OUT tx seq=(\d+) echo=(\d+) link=(\d+) eb=(\d+) abnormal=(\d+)")
-_OUT_RX = re.compile(r"@OUT rx verdict=(\d+) gap=(\d+) link=(\d+) eb=(\d+) abnormal=(\d+)")
-
-
-def parse_events(text: str):
-    """Turn replay/simulation output into a list of raw (input, output) events."""
-    events, pending = [], None
-    for line in text.splitlines():
-        if m := _IN_TICK.search(line):
-            pending = {"ev": "tick"}
-        elif m := _IN_RX.search(line):
-            pending = {"ev": "rx", "seq": int(m[1]), "echo": int(m[2]), "mode": int(m[3])}
-        elif m := _OUT_TX.search(line):
-            if pending is None or pending["ev"] != "tick":
-                raise PipelineError(f"@OUT tx without @IN tick: {line.strip()}")
-            events.append((pending, {"seq": int(m[1]), "echo": int(m[2]), "link": int(m[3]),
-                                     "eb": int(m[4]), "abnormal": int(m[5])}))
-            pending = None
-        elif m := _OUT_RX.search(line):
-            if pending is None or pending["ev"] != "rx":
-                raise PipelineError(f"@OUT rx without @IN rx: {line.strip()}")
-            events.append((pending, {"verdict": int(m[1]), "gap": int(m[2]), "link": int(m[3]),
-                                     "eb": int(m[4]), "abnormal": int(m[5])}))
-            pending = None
-    # an input whose output was cut off by the end of a trail is dropped
-    return events
-
-
-def _role_out(role, o):
-    base = {"link": LINKS[o["link"]]}
-    if role == "train":
-        base["eb"] = bool(o["eb"])
-    else:
-        base["tracking"] = "ABNORMAL" if o["abnormal"] else "TRACKED"
-    return base
-
-
-def to_steps(events, role, ids):
-    """Map raw events to the vector step format of one endpoint role."""
-    steps = []
-    own, peer, other = (ids["ground_id"], ids["train_id"], ids["other_train_id"])
-    for i, o in events:
-        if i["ev"] == "tick":
-            out = {"tx": {"seq": o["seq"], "echo": None if o["echo"] == NONE else o["echo"]}}
-            out.update(_role_out(role, o))
-            steps.append({"in": {"ev": "tick"}, "out": out})
-            continue
-        mode = i["mode"]
-        if role == "ground":
-            src, dst, typ = peer, own, "POSITION"
-            if mode == MODE_MISADDR:
-                src = other
-        else:
-            src, dst, typ = own, peer, "CONTROL"
-            if mode == MODE_MISADDR:
-                dst = other
-        tg = {"src": src, "dst": dst, "type": typ, "seq": i["seq"],
-              "echo": None if i["echo"] == NONE else i["echo"],
-              "auth": "nokey" if mode == MODE_FORGE else "key",
-              "integrity": "corrupt" if mode == MODE_CORRUPT else "ok"}
-        out = {"verdict": VERDICTS[o["verdict"]], "gap": o["gap"]}
-        out.update(_role_out(role, o))
-        steps.append({"in": {"ev": "rx", "tg": tg}, "out": out})
-    return steps
-
-
-def observed_requirements(events):
-    reqs = set()
-    prev_link = 0
-    for i, o in events:
-        if i["ev"] == "rx":
-            reqs.update(VERDICT_REQS[VERDICTS[o["verdict"]]])
-        if prev_link == 1 and o["link"] == 2:
-            reqs.update(LOST_REQS)
-        prev_link = o["link"]
-    return reqs
-
-
-ROLES = ("ground", "train")
-
-
-def vectors_for_roles(stem, events, ids, requirements, goal, kind, seed):
-    """One run of the model becomes one vector per endpoint role (same logic, the
-    identifiers, telegram types and safe-reaction output differ)."""
-    return [{"id": f"{stem}-{role}", "role": role, "requirements": requirements, "goal": goal,
-             "kind": kind, "seed": seed, "steps": to_steps(events, role, ids)} for role in ROLES]
-
-
-def search_goal(model: Path, base: Path, workdir: Path, g, defines, parser=None):
-    """Run the trap property of goal g on a copy of the compiled pan in `base`; return
-    (status, events, pan results): reached with the replayed run, or unreachable."""
-    tag = "".join(f"-{d}" for d in defines if d != "TRAPS")
-    wd = workdir / f"goal{g.number}{tag}"
-    if wd.exists():
-        shutil.rmtree(wd)
-    shutil.copytree(base, wd)
-    r = spin_mod._run(["./pan", "-N", f"goal{g.number}"], wd)
-    res = spin_mod.parse_pan(r.stdout + r.stderr)
-    if res["errors"]:
-        rep = spin_mod._run(["spin", *[f"-D{d}" for d in defines], "-t", model.name], wd, timeout=300)
-        events = (parser or parse_events)(rep.stdout)
-        if not events:
-            raise PipelineError(f"{model.name}: goal {g.gid}{tag} trail replay produced no events:\n"
-                                f"{rep.stdout[-2000:]}")
-        return "reached", events, res
-    if res["incomplete"]:
-        raise PipelineError(f"{model.name}: goal {g.gid}{tag}: search incomplete "
-                            f"({'; '.join(res['incomplete'])})")
-    return "unreachable", None, res
-
-
-def write_goals_file(ann, path: Path):
-    lines = ["/* Generated by railproof_testgen vectors: one trap property per coverage goal. */"]
-    for g in ann.goals:
-        lines.append(f"ltl goal{g.number} {{ [] !g[{g.number}] }}")
-    path.write_text("\n".join(lines) + "\n", encoding="utf-8")
-
-
-def load_justifications(spec_dir: Path, model_rel: str):
-    out = {}
-    jdir = Path(spec_dir) / "justifications"
-    for f in sorted(jdir.glob("*.yaml")) if jdir.exists() else []:
-        data = load_yaml(f)
-        for e in data.get("justifications") or []:
-            if e.get("model") == model_rel:
-                out[str(e.get("goal"))] = e["id"]
-    return out
+REACHED, UNREACHABLE = "reached", "unreachable"
+KINDS = ("trap", "boundary", "random")
 
 
 def _progress(msg):
     print(f"vectors: {msg}", flush=True)
 
 
-def model_bounds(params_pml: Path):
-    """The model bounds of a generated <model>_params.pml, keyed without their "model_"
-    prefix (shared by the moving-block and braking generators)."""
+# ---- what a capability contributes ------------------------------------------------------------
+@dataclass(frozen=True)
+class Configuration:
+    """A configuration of the model in which vectors are generated.
+
+    define: its -D symbol (None: the model's default configuration).
+    suffix: its vectors go to <model><suffix>.jsonl ("" the model's main file); configurations
+            that share a suffix share the file, whose header is that of the first of them in
+            the table.
+    tag:    put in its vector ids (Part.vector_id).
+    walks:  random walks in it: 0 none, 1 the --walks count, k > 1 that count // k (at least one).
+    walk_evidence: its walks also evidence the requirements of the properties verified in it."""
+    define: str | None
+    suffix: str = ""
+    tag: str = ""
+    walks: int = 0
+    walk_evidence: bool = False
+
+    @property
+    def name(self) -> str:
+        return self.define or "default"
+
+    def walk_count(self, walks: int) -> int:
+        """The number of random walks in this configuration for --walks `walks`."""
+        if self.walks <= 0:
+            return 0
+        return walks if self.walks == 1 else max(1, walks // self.walks)
+
+
+class Part(ABC):
+    """A capability's part of vector generation: capabilities/<cap>.py defines PART, an instance
+    of a subclass that sets prefix and configurations and implements the abstract methods
+    (bounds, parse_events, to_steps, observed_requirements, header); the other members have
+    the common default.
+    A configuration is named by its define (None: the model's default configuration)."""
+    prefix: str = ""                  # vector ids begin <prefix>-<KIND>-
+    configurations: tuple = ()        # Configuration, the model's default one first
+    boundary_words = ("boundary",)    # a goal label containing one gives a boundary vector
+    variant_search = "all"            # default-configuration goals searched in each @variant
+    walk_defines = ("WALK",)          # -D symbols of a random walk
+    walk_steps = None                 # a walk's length in SPIN statements (spin -u), if the model
+    #                                   does not end it itself
+    walk_events = None                # the model bound giving a walk's number of events (None: any, >= 1)
+
+    def configuration(self, define) -> Configuration:
+        for c in self.configurations:
+            if c.define == define:
+                return c
+        raise KeyError(define)
+
+    # what the capability implements
+    @abstractmethod
+    def bounds(self, model: Path, params_pml: Path) -> dict:
+        """The model bounds the part needs (model_bounds of the generated <model>_params.pml)."""
+
+    @abstractmethod
+    def parse_events(self, text: str) -> list:
+        """The events of a replay or walk (spin's output: the model's @IN/@OUT lines)."""
+
+    @abstractmethod
+    def to_steps(self, events: list, bounds: dict, define) -> list:
+        """The events as the steps of a vector (the capability's schema)."""
+
+    @abstractmethod
+    def observed_requirements(self, steps: list) -> set:
+        """The requirements a run shows (added to a goal's own)."""
+
+    @abstractmethod
+    def header(self, target: "Target", define) -> dict:
+        """The header line of the file of a configuration (Target.header and the part's fields)."""
+
+    # the common rules, overridden where a capability has its own
+    def walk_length(self, bounds: dict, define) -> int | None:
+        """The number of events a random walk must give (None: at least one)."""
+        return bounds[self.walk_events] if self.walk_events else None
+
+    def vector_id(self, kind: str, define, tail: str) -> str:
+        """tail: the goal (G<k>) or the seed (S<seed>)."""
+        return f"{self.prefix}-{kind.upper()}-{self.configuration(define).tag}{tail}"
+
+    def vectors(self, target: "Target", define, events, vid: str, kind: str, goal: str | None,
+                seed: int | None, requirements) -> list:
+        """The vectors of one run of the model: one, with the requirements it shows."""
+        steps = self.to_steps(events, target.bounds, define)
+        return [{"id": vid, "requirements": sorted(set(requirements) | self.observed_requirements(steps)),
+                 "goal": goal, "kind": kind, "seed": seed, "steps": steps}]
+
+    def order(self, define, vectors: list) -> list:
+        """The order of a file's vectors (define: the file's configuration): boundary, trap, then
+        random vectors, each by goal or seed number."""
+        return sorted(vectors, key=lambda v: (v["kind"] == "random", v["kind"] == "trap", id_order(v["id"])))
+
+
+def id_order(vid: str):
+    """Sort key of an id by its last number (G<k>, S<seed>), numerically."""
+    m = re.search(r"(\d+)$", vid)
+    return (vid[: m.start()] if m else vid, int(m.group(1)) if m else 0)
+
+
+def model_bounds(params_pml: Path, required=()) -> dict:
+    """The model bounds of a generated <model>_params.pml (MODEL_<NAME> -> name, a "model_"
+    prefix of the name dropped); a required one missing is an error naming it."""
     raw = spin_mod.read_bounds(params_pml)
-    return {k[len("model_"):] if k.startswith("model_") else k: v for k, v in raw.items()}
+    b = {k[len("model_"):] if k.startswith("model_") else k: v for k, v in raw.items()}
+    area = Path(params_pml).stem.removesuffix("_params")
+    for key in required:
+        if key not in b:
+            raise SpecError(params_pml, f"MODEL_{key.upper()}",
+                            f"model bound missing (spec/parameters/{area}.yaml model_bounds)")
+    return b
 
 
-def generate(model: Path, params_dir: Path, spec_dir: Path, workdir: Path, out_dir: Path,
-             walks: int = 50, walk_steps: int = 7000, jobs: int = 2):
-    model = Path(model)
-    if model.stem == "mb":
-        from .capabilities import mb as mb_vectors
-        return mb_vectors.generate(model, params_dir, spec_dir, workdir, out_dir, walks, jobs)
-    if model.stem == "br":
-        from .capabilities import br as br_vectors
-        return br_vectors.generate(model, params_dir, spec_dir, workdir, out_dir, walks, jobs)
-    if model.stem == "ra":
-        from .capabilities import ra as ra_vectors
-        return ra_vectors.generate(model, params_dir, spec_dir, workdir, out_dir, walks, jobs)
-    if model.stem == "lc":
-        from .capabilities import lc as lc_vectors
-        return lc_vectors.generate(model, params_dir, spec_dir, workdir, out_dir, walks, jobs)
-    model_rel = f"models/{model.name}"
-    ann = spin_mod.parse_annotations(model)
-    if not ann.goals:
-        raise SpecError(model, "-", "no // @goal annotations: nothing to generate")
-    params_pml = Path(params_dir) / f"{model.stem}_params.pml"
-    bounds = spin_mod.read_bounds(params_pml)
-    workdir = Path(workdir)
-    workdir.mkdir(parents=True, exist_ok=True)
-    goals_file = workdir / f"{model.stem}_goals.pml"
-    write_goals_file(ann, goals_file)
-    _progress(f"compiling trap model ({len(ann.goals)} goals)")
-    base = spin_mod.prepare(model, params_dir, workdir / "traps", ["TRAPS"], [goals_file])
+@dataclass
+class Target:
+    """The model the vectors are generated from, as the parts see it."""
+    path: Path
+    annotations: spin_mod.Annotations
+    bounds: dict
+    spin_version: str
 
-    def run_goal(g):
-        return (g, *search_goal(model, base, workdir, g, ["TRAPS"]))
+    @property
+    def rel(self) -> str:
+        return f"models/{self.path.name}"
 
-    with ThreadPoolExecutor(max_workers=max(1, jobs)) as ex:
-        outcomes = list(ex.map(run_goal, ann.goals))
+    @cached_property
+    def sha256(self) -> str:
+        return spin_mod.sha256_file(self.path)
 
-    justifications = load_justifications(spec_dir, model_rel)
-    ids = {"ground_id": bounds["ground_id"], "train_id": bounds["train_id"],
-           "other_train_id": bounds["other_train_id"]}
-    vectors, coverage, problems = [], [], []
-    for g, status, events, res in outcomes:
-        vec_ids = []
-        if status == "reached":
-            kind = "boundary" if any(w in g.label.lower() for w in BOUNDARY_WORDS) else "trap"
-            reqs = sorted(set(g.requirements) | observed_requirements(events))
-            made = vectors_for_roles(f"TG-{kind.upper()}-{g.gid}", events, ids, reqs, g.gid, kind, None)
-            vec_ids.extend(v["id"] for v in made)
-            vectors.extend(made)
-            _progress(f"{g.gid} reached in {len(events)} steps: {g.label}")
-        else:
-            _progress(f"{g.gid} UNREACHABLE ({res['states_stored']} states searched): {g.label}")
-        just = justifications.get(g.gid)
-        if status == "unreachable" and not just:
-            problems.append(f"goal {g.gid} ({g.label}) is unreachable and has no justification in "
-                            f"spec/justifications/ (model {model_rel})")
-        coverage.append({"id": g.gid, "label": g.label, "requirements": g.requirements, "status": status,
-                         "vectors": vec_ids, "justification": just if status == "unreachable" else None,
-                         "states_searched": res["states_stored"] if status == "unreachable" else None})
-    # Boundary variants: goals unreachable in the main configuration are searched again in
-    # each variant; a goal reached there yields vectors in a file of its own, whose header
-    # carries the variant's parameter.
-    variant_files = {}
-    unreachable = [g for g, status, _, _ in outcomes if status == "unreachable"]
-    for v in ann.variants if unreachable else []:
-        _progress(f"variant {v.define}: searching {len(unreachable)} goal(s) unreachable in the main configuration")
-        vbase = spin_mod.prepare(model, params_dir, workdir / f"traps-{v.define}", ["TRAPS", v.define], [goals_file])
-        vvecs = []
-        for g in unreachable:
-            status, events, _res = search_goal(model, vbase, workdir, g, ["TRAPS", v.define])
-            if status != "reached":
-                _progress(f"{g.gid} unreachable in {v.define} too")
-                continue
-            reqs = sorted(set(g.requirements) | observed_requirements(events))
-            suffix = v.define.lower().replace("variant_", "").replace("_", "")
-            vvecs.extend(vectors_for_roles(f"TG-BOUNDARY-{g.gid}{suffix}", events, ids, reqs, g.gid,
-                                           "boundary", None))
-            cov_entry = next(c for c in coverage if c["id"] == g.gid)
-            cov_entry.setdefault("variant_vectors", []).extend(x["id"] for x in vvecs[-len(ROLES):])
-            cov_entry["variant"] = v.define
-            _progress(f"{g.gid} reached in variant {v.define} in {len(events)} steps")
-        if vvecs:
-            if v.bound not in bounds:
-                raise SpecError(model, v.define, f"variant names unknown model bound {v.bound}")
-            variant_files[v.define.lower()] = (v, vvecs)
-    for gid in sorted(set(justifications) - {c["id"] for c in coverage if c["status"] == "unreachable"}):
-        problems.append(f"justification {justifications[gid]} names goal {gid}, which is reached or unknown")
+    def header(self, **fields) -> dict:
+        """A vector file's header: the fields every header has, then the part's."""
+        return {"kind": "header", "schema_version": 1, "model": self.rel, "model_sha256": self.sha256,
+                "generator": f"railproof_testgen {__version__}", "spin_version": self.spin_version, **fields}
 
-    _progress(f"{walks} random walks of {walk_steps} SPIN statements each")
-    sim_dir = workdir / "traps"
-
-    def walk(seed, config=None):
-        # spin writes scratch files into its working directory: one directory per walk
-        wd = workdir / f"walk{seed}{'-' + config if config else ''}"
-        if wd.exists():
-            shutil.rmtree(wd)
-        wd.mkdir()
-        for f in sim_dir.glob("*.pml"):
-            shutil.copy2(f, wd / f.name)
-        dflags = [f"-D{config}"] if config else []
-        r = spin_mod._run(["spin", *dflags, f"-n{seed}", f"-u{walk_steps}", model.name], wd, timeout=300)
-        if r.returncode != 0:
-            raise PipelineError(f"spin simulation seed {seed} failed: {r.stderr[-1000:]}")
-        return seed, parse_events(r.stdout)
-
-    with ThreadPoolExecutor(max_workers=max(1, jobs)) as ex:
-        walks_out = list(ex.map(walk, range(1, walks + 1)))
-    for seed, events in walks_out:
-        if not events:
-            raise PipelineError(f"random walk seed {seed} produced no events")
-        reqs = sorted(observed_requirements(events))
-        vectors.extend(vectors_for_roles(f"TG-RANDOM-S{seed}", events, ids, reqs, None, "random", seed))
-
-    # Walks in the other configurations of the model (e.g. HEALTHY: a perfect channel),
-    # evidence for the properties verified in that configuration.
-    for config in sorted({c for p in ann.properties for c in p.configs if c}):
-        creqs = sorted({r for p in ann.properties if config in p.configs for r in p.requirements})
-        n_cfg = max(1, walks // 10)
-        _progress(f"{n_cfg} random walks in configuration {config}")
-        for seed in range(1, n_cfg + 1):
-            _, events = walk(seed, config)
-            if not events:
-                raise PipelineError(f"random walk seed {seed} [{config}] produced no events")
-            reqs = sorted(set(creqs) | observed_requirements(events))
-            vectors.extend(vectors_for_roles(f"TG-RANDOM-{config}S{seed}", events, ids, reqs, None,
-                                             "random", seed))
-
-    header = {
-        # the main configuration header (variants override one parameter)
-        "kind": "header", "schema_version": 1, "model": model_rel,
-        "model_sha256": spin_mod.sha256_file(model),
-        "generator": f"railproof_testgen {__version__}", "spin_version": spin_mod.spin_version(),
-        "unit_scales": {"time_ms_per_tick": bounds["tick_ms"]},
-        "parameters": {
-            "seq_modulus": bounds["seq_modulus"], "seq_window": bounds["seq_window"],
-            "history_depth": bounds["history_depth"],
-            "turnaround_ms": bounds["turnaround_ticks"] * bounds["tick_ms"],
-            "link_timeout_ms": bounds["link_ticks"] * bounds["tick_ms"],
-            "echo_validity_ms": bounds["echo_ticks"] * bounds["tick_ms"],
-            "init_own_seq": bounds["init_own_seq"], "init_peer_seq": bounds["init_peer_seq"],
-            **ids},
-    }
-    def checked(lines, name):
-        return schema_checked_jsonl(Path(spec_dir) / "schemas" / "vectors_tg.schema.json", lines, name)
-
-    out_dir = Path(out_dir)
-    out_dir.mkdir(parents=True, exist_ok=True)
-    for old in out_dir.glob(f"{model.stem}.*.jsonl"):
-        old.unlink()  # variant files of an earlier run
-    for suffix, (v, vvecs) in sorted(variant_files.items()):
-        vheader = json.loads(json.dumps(header))
-        vheader["parameters"][v.parameter] = bounds[v.bound]
-        vheader["variant"] = v.define
-        name = f"{model.stem}.{suffix}.jsonl"
-        _atomic_write(out_dir / name, checked([vheader, *vvecs], name))
-    lines = [header, *vectors]
-    reached = sum(1 for c in coverage if c["status"] == "reached")
-    cov = {"schema": "railproof/coverage/1", "model": model_rel, "goals": coverage, "reached": reached,
-           "labelled": len(coverage), "unreachable_justified": sum(
-               1 for c in coverage if c["status"] == "unreachable" and c["justification"]),
-           "vectors": {"trap": sum(v["kind"] == "trap" for v in vectors),
-                       "boundary": sum(v["kind"] == "boundary" for v in vectors),
-                       "random": sum(v["kind"] == "random" for v in vectors),
-                       "variant_boundary": sum(len(vv) for _, vv in variant_files.values())}}
-    _atomic_write(out_dir / f"{model.stem}.jsonl", checked(lines, f"{model.stem}.jsonl"))
-    _atomic_write(out_dir / f"{model.stem}.coverage.json", json.dumps(cov, indent=2, sort_keys=True) + "\n")
-    _progress(f"goal coverage {reached}/{len(coverage)} reached, "
-              f"{cov['unreachable_justified']} unreachable justified; {len(vectors)} vectors written")
-    if problems:
-        raise PipelineError(f"{model.name}: " + "; ".join(problems))
-    return cov
+    def property_requirements(self, define) -> set:
+        return {r for p in self.annotations.properties if define in p.configs for r in p.requirements}
 
 
+def capability_part(spec_dir: Path, model: Path):
+    """(capability name, PART of capabilities/<name>.py) of the capability the registry
+    lists the model under."""
+    reg = registry_mod.load(spec_dir)
+    cap = reg.of_model(model)
+    if cap is None:
+        raise SpecError(reg.file, Path(model).stem, f"no capability lists the model {Path(model).name}")
+    try:
+        mod = importlib.import_module(f"{__package__}.capabilities.{cap.name}")
+    except ModuleNotFoundError as exc:
+        if exc.name != f"{__package__}.capabilities.{cap.name}":
+            raise
+        raise SpecError(cap.vector_part, cap.name, "missing: the capability's part of vector generation") from None
+    part = getattr(mod, "PART", None)
+    if not isinstance(part, Part):
+        raise SpecError(cap.vector_part, "PART", "must be an instance of railproof_testgen.vectors.Part")
+    return cap.name, part
+
+
+def load_justifications(spec_dir: Path, capability: str, model_rel: str) -> dict:
+    """{goal: justification id} of spec/justifications/<capability>.yaml for the model."""
+    f = Path(spec_dir) / "justifications" / f"{capability}.yaml"
+    if not f.is_file():
+        return {}
+    out = {}
+    for i, e in enumerate(load_yaml(f).get("justifications") or []):
+        if not isinstance(e, dict) or not all(isinstance(e.get(k), str) for k in ("id", "goal", "model")):
+            raise SpecError(f, f"justifications[{i}]", "an entry needs 'id', 'goal' and 'model'")
+        if e["model"] != model_rel:
+            continue
+        if e["goal"] in out:
+            raise SpecError(f, e["id"], f"goal {e['goal']} is already justified by {out[e['goal']]}")
+        out[e["goal"]] = e["id"]
+    return out
+
+
+# ---- files ------------------------------------------------------------------------------------
 def _most_specific(err):
-    """The deepest error under a oneOf/anyOf failure, so that a message names the field that
-    is wrong (e.g. steps/0/onboard/in/reports/0: 'requesters' is a required property) instead
-    of quoting the whole line."""
+    """Under a oneOf/anyOf failure, the deepest error of the alternative that fails least (the
+    one the line was meant to be), so that a message names the field that is wrong (e.g.
+    steps/0/onboard/in/reports/0: 'requesters' is a required property) instead of quoting the
+    whole line or blaming another alternative."""
     while err is not None and err.context:
-        err = max(err.context, key=lambda e: len(e.absolute_path))
+        alternatives = {}
+        for e in err.context:
+            alternatives.setdefault(e.relative_schema_path[0], []).append(e)
+        err = max(min(alternatives.values(), key=len), key=lambda e: len(e.absolute_path))
     return err
 
 
 def schema_checked_jsonl(schema_path: Path, lines, name: str) -> str:
-    """Validate every line (header and vectors) against the JSON schema of the vector
-    format and return the JSON Lines text; a line that violates it is a PipelineError naming
-    the file, line and field (nothing is written). Shared by every vector generator."""
+    """Validate every line (header and vectors) against the JSON schema of the vector format
+    and return the JSON Lines text; a line that violates it is a PipelineError naming the
+    file, line and field."""
     schema = json.loads(Path(schema_path).read_text(encoding="utf-8"))
     validator = jsonschema.Draft202012Validator(schema)
     for n, obj in enumerate(lines, 1):
@@ -378,67 +259,259 @@ def schema_checked_jsonl(schema_path: Path, lines, name: str) -> str:
     return "".join(json.dumps(o, sort_keys=True, separators=(",", ":")) + "\n" for o in lines)
 
 
-def _atomic_write(path: Path, text: str):
-    tmp = path.with_suffix(path.suffix + ".tmp")
-    tmp.write_text(text, encoding="utf-8")
-    tmp.replace(path)
+def atomic_write(path: Path, text: str):
+    """Write a file completely or not at all (a temporary file renamed over it)."""
+    path = Path(path)
+    tmp = path.with_name(path.name + ".tmp")
+    try:
+        tmp.write_text(text, encoding="utf-8")
+        tmp.replace(path)
+    finally:
+        tmp.unlink(missing_ok=True)
 
 
-def _id_order(vid: str):
-    """Sort key: numeric part of G<k> / S<seed> ids."""
-    m = re.search(r"(\d+)$", vid)
-    return (vid[: m.start()] if m else vid, int(m.group(1)) if m else 0)
+# ---- the engine -------------------------------------------------------------------------------
+@dataclass
+class Outcome:
+    """A goal's search in one configuration."""
+    status: str                 # REACHED or UNREACHABLE
+    events: list | None         # the parsed replay of its trail (reached)
+    states: int | None          # states of the complete search (unreachable)
 
 
-def write_configuration_files(model: Path, model_rel: str, ann, coverage: dict, per_config: dict,
-                              suffixes: dict, header_for, schema: Path, out_dir: Path,
-                              problems: list) -> dict:
-    """The shared end of the generators that write one vector file per model configuration
-    (readhesion, level crossing): sort each file's vectors (boundary, trap, random; by goal
-    or seed), check every line against the schema before anything is written, write the
-    files and the coverage record atomically, remove the files of configurations no longer
-    generated, and fail with the collected problems. suffixes: configuration -> file-name
-    suffix; header_for(configuration) -> the file's header line."""
-    for vecs in per_config.values():
-        vecs.sort(key=lambda v: (v["kind"] == "random", v["kind"] == "trap", _id_order(v["id"])))
-    out_dir = Path(out_dir)
-    out_dir.mkdir(parents=True, exist_ok=True)
-    texts = {}
-    for cfg, vecs in per_config.items():
-        name = f"{model.stem}{suffixes[cfg]}.jsonl"
-        texts[name] = schema_checked_jsonl(schema, [header_for(cfg), *vecs], name)
-    all_vecs = [v for vecs in per_config.values() for v in vecs]
-    cov_goals = [coverage[g.gid] for g in ann.goals]
-    reached = sum(1 for c in cov_goals if c["status"] == "reached")
-    cov = {"schema": "railproof/coverage/1", "model": model_rel, "goals": cov_goals, "reached": reached,
-           "labelled": len(cov_goals), "unreachable_justified": sum(
-               1 for c in cov_goals if c["status"] == "unreachable" and c["justification"]),
-           "vectors": {k: sum(v["kind"] == k for v in all_vecs) for k in ("trap", "boundary", "random")},
-           "files": {f"{model.stem}{suffixes[c]}.jsonl": len(v) for c, v in per_config.items()}}
-    for old in out_dir.glob(f"{model.stem}.*.jsonl"):
-        if old.name not in texts:
-            old.unlink()  # a file of an earlier configuration set
-    for name, text in texts.items():
-        _atomic_write(out_dir / name, text)
-    _atomic_write(out_dir / f"{model.stem}.coverage.json", json.dumps(cov, indent=2, sort_keys=True) + "\n")
-    _progress(f"goal coverage {reached}/{len(cov_goals)} reached, {cov['unreachable_justified']} "
-              f"unreachable justified; {len(all_vecs)} vectors written "
-              f"({', '.join(f'{n}: {k}' for n, k in cov['files'].items())})")
-    if problems:
-        raise PipelineError(f"{model.name}: " + "; ".join(problems))
-    return cov
+class Generation:
+    """One run of the vectors command for one model and its capability's part."""
+
+    def __init__(self, capability: str, part: Part, model: Path, params_dir: Path, spec_dir: Path,
+                 workdir: Path, out_dir: Path, walks: int, walk_steps: int | None, jobs: int):
+        self.capability, self.part = capability, part
+        self.model, self.params_dir, self.spec_dir = Path(model), Path(params_dir), Path(spec_dir)
+        self.workdir, self.out_dir = Path(workdir), Path(out_dir)
+        self.walks, self.jobs = walks, max(1, jobs)
+        self.walk_steps = walk_steps if walk_steps is not None else part.walk_steps
+        if walk_steps is not None and part.walk_steps is None:
+            raise SpecError(self.model, "--walk-steps", f"the model ends its random walks itself (capability "
+                                                        f"{capability}: no walk length in SPIN statements)")
+        if part.variant_search not in ("all", "unreachable"):
+            raise SpecError(f"capabilities/{capability}.py", "variant_search",
+                            f"{part.variant_search!r} is neither 'all' nor 'unreachable'")
+        ann = spin_mod.parse_annotations(self.model)
+        if not ann.goals:
+            raise SpecError(self.model, "-", "no // @goal annotations: nothing to generate")
+        known = {c.define for c in part.configurations}
+        for g in ann.goals:
+            if g.config not in known:
+                raise SpecError(self.model, g.gid, f"goal in configuration {g.config}, in which capability "
+                                                   f"{capability} generates no vectors (capabilities/{capability}.py)")
+        for v in ann.variants:
+            if v.define not in known:
+                raise SpecError(self.model, v.define, f"variant in which capability {capability} generates "
+                                                      f"no vectors (capabilities/{capability}.py)")
+        bounds = part.bounds(self.model, self.params_dir / f"{self.model.stem}_params.pml")
+        self.target = Target(self.model, ann, bounds, spin_mod.spin_version())
+        self.schema = self.spec_dir / "schemas" / f"vectors_{capability}.schema.json"
+        self.justification_file = f"spec/justifications/{capability}.yaml"
+        self.justifications = load_justifications(self.spec_dir, capability, self.target.rel)
+
+    @property
+    def ann(self):
+        return self.target.annotations
+
+    def pool(self):
+        return ThreadPoolExecutor(max_workers=self.jobs)
+
+    # ---- trap searches ----------------------------------------------------------------------
+    def search(self, plan: dict) -> dict:
+        """plan: {define: [goals]} -> {(goal number, define): Outcome}. One search per
+        configuration, then the replay of every trail, in parallel."""
+        plan = {d: gs for d, gs in plan.items() if gs}
+
+        def run(define):
+            name = self.part.configuration(define).name
+            _progress(f"[{name}] compiling the trap model and searching {len(plan[define])} goal(s) at once")
+            s = spin_mod.search_goals(self.model, self.params_dir, self.workdir / f"traps-{name}",
+                                      ["TRAPS"] + ([define] if define else []), [g.number for g in plan[define]],
+                                      self.ann.pan_flags)
+            _progress(f"[{name}] {len(s.trails)} of {len(plan[define])} goal(s) reached "
+                      f"({s.res['states_stored']} states, {s.res['time_s']} s)")
+            return define, s
+
+        with self.pool() as ex:
+            searches = dict(ex.map(run, plan))
+            trails = [(d, t) for d, s in searches.items() for t in sorted(set(s.trails.values()))]
+
+            def replay(job):
+                define, trail = job
+                s = searches[define]
+                return job, self.part.parse_events(s.replay(trail, s.dir / f"replay-{trail}"))
+
+            replayed = dict(ex.map(replay, trails))
+        out = {}
+        for define, goals in plan.items():
+            s = searches[define]
+            for g in goals:
+                if g.number not in s.trails:
+                    out[(g.number, define)] = Outcome(UNREACHABLE, None, s.res["states_stored"])
+                    continue
+                events = replayed[(define, s.trails[g.number])]
+                if not events:
+                    raise PipelineError(f"{self.model.name}: goal {g.gid} [{self.part.configuration(define).name}]: "
+                                        f"the replay of its trail produced no events")
+                out[(g.number, define)] = Outcome(REACHED, events, None)
+        return out
+
+    def search_plan(self):
+        """Every goal in its configuration, then in the variants (Part.variant_search)."""
+        plan = {}
+        for g in self.ann.goals:
+            plan.setdefault(g.config, []).append(g)
+        default_goals = plan.get(None, [])
+        if self.part.variant_search == "all":
+            for v in self.ann.variants:
+                plan.setdefault(v.define, []).extend(default_goals)
+        outcomes = self.search(plan)
+        if self.part.variant_search == "unreachable":
+            missing = [g for g in default_goals if outcomes[(g.number, None)].status == UNREACHABLE]
+            if missing and self.ann.variants:
+                _progress(f"variants {', '.join(v.define for v in self.ann.variants)}: searching "
+                          f"{len(missing)} goal(s) unreachable in the default configuration")
+                outcomes.update(self.search({v.define: missing for v in self.ann.variants}))
+        return outcomes
+
+    # ---- random walks ---------------------------------------------------------------------
+    def walk(self, job):
+        define, seed = job
+        name = self.part.configuration(define).name
+        # spin writes scratch files into its working directory: one directory per walk
+        wd = spin_mod.stage(self.model, self.params_dir, self.workdir / f"walk{seed}-{name}")
+        flags = [f"-D{d}" for d in (*self.part.walk_defines, *([define] if define else []))]
+        flags += [f"-n{seed}"] + ([f"-u{self.walk_steps}"] if self.walk_steps else [])
+        r = spin_mod._run(["spin", *flags, self.model.name], wd, timeout=300)
+        if r.returncode != 0:
+            raise PipelineError(f"{self.model.name}: random walk seed {seed} [{name}] failed: {r.stderr[-1000:]}")
+        events = self.part.parse_events(r.stdout)
+        want = self.part.walk_length(self.target.bounds, define)
+        if (want is None and not events) or (want is not None and len(events) != want):
+            raise PipelineError(f"{self.model.name}: random walk seed {seed} [{name}] produced {len(events)} "
+                                f"event(s), expected {want if want is not None else 'at least one'}")
+        return job, events
+
+    # ---- the whole run --------------------------------------------------------------------
+    def run(self) -> dict:
+        self.workdir.mkdir(parents=True, exist_ok=True)
+        per_config = {c.define: [] for c in self.part.configurations}  # the vectors of each configuration
+        coverage, problems = self.goal_vectors(self.search_plan(), per_config)
+        self.walk_vectors(per_config)
+        return self.write(coverage, per_config, problems)
+
+    def goal_vectors(self, outcomes: dict, per_config: dict):
+        """The vectors of the reached goals and the coverage record of every goal; the problems
+        of the justifications (an unreachable goal without one, one for a goal that is not)."""
+        part, target = self.part, self.target
+        coverage, problems = [], []
+
+        def made(g, define, outcome):
+            kind = "boundary" if any(w in g.label.lower() for w in part.boundary_words) else "trap"
+            vecs = part.vectors(target, define, outcome.events, part.vector_id(kind, define, g.gid), kind,
+                                g.gid, None, g.requirements)
+            per_config[define].extend(vecs)
+            return [v["id"] for v in vecs]
+
+        for g in self.ann.goals:
+            home = outcomes[(g.number, g.config)]
+            where = part.configuration(g.config).name
+            entry = {"id": g.gid, "label": g.label, "requirements": g.requirements, "status": home.status,
+                     "configuration": where, "vectors": [], "justification": None, "states_searched": None}
+            if home.status == REACHED:
+                entry["vectors"] = made(g, g.config, home)
+                _progress(f"{g.gid} [{where}] reached in {len(home.events)} step(s): {g.label}")
+            else:
+                entry["justification"] = self.justifications.get(g.gid)
+                entry["states_searched"] = home.states
+                _progress(f"{g.gid} [{where}] UNREACHABLE ({home.states} states searched): {g.label}")
+                if not entry["justification"]:
+                    problems.append(f"{self.justification_file}: {g.gid}: goal unreachable in {where} "
+                                    f"({g.label}) and not justified (model {target.rel})")
+            for v in self.ann.variants if g.config is None else []:
+                found = outcomes.get((g.number, v.define))
+                if found is not None and found.status == REACHED:
+                    entry.setdefault("variant_vectors", []).extend(made(g, v.define, found))
+                    entry["variant"] = v.define
+                    _progress(f"{g.gid} reached in variant {v.define} in {len(found.events)} step(s)")
+            coverage.append(entry)
+        unreachable = {c["id"] for c in coverage if c["status"] == UNREACHABLE}
+        for gid, jid in sorted(self.justifications.items()):
+            if gid not in unreachable:
+                what = "reached" if any(c["id"] == gid for c in coverage) else "not a goal of the model"
+                problems.append(f"{self.justification_file}: {jid}: justifies goal {gid}, which is {what}")
+        return coverage, problems
+
+    def walk_vectors(self, per_config: dict):
+        """The random walks of every configuration the part gives walks to."""
+        part, target = self.part, self.target
+        counts = {c.define: c.walk_count(self.walks) for c in part.configurations}
+        jobs = [(define, seed) for define, n in counts.items() for seed in range(1, n + 1)]
+        _progress(f"{len(jobs)} random walks (" + ", ".join(f"{n} in {part.configuration(d).name}"
+                                                           for d, n in counts.items() if n) + ")")
+        with self.pool() as ex:
+            walked = list(ex.map(self.walk, jobs))
+        for (define, seed), events in walked:
+            extra = target.property_requirements(define) if part.configuration(define).walk_evidence else set()
+            per_config[define].extend(part.vectors(target, define, events, part.vector_id("random", define, f"S{seed}"),
+                                                   "random", None, seed, extra))
+
+    def write(self, coverage, per_config, problems) -> dict:
+        part, stem = self.part, self.model.stem
+        files = {}  # file name -> (configuration of its header, vectors)
+        for c in part.configurations:
+            name = f"{stem}{c.suffix}.jsonl"
+            files.setdefault(name, (c.define, []))[1].extend(per_config[c.define])
+        texts = {}
+        for name, (define, vecs) in files.items():
+            if vecs or name == f"{stem}.jsonl":
+                lines = [part.header(self.target, define), *part.order(define, vecs)]
+                texts[name] = schema_checked_jsonl(self.schema, lines, name)
+        all_vecs = [v for _, vecs in files.values() for v in vecs]
+        reached = sum(c["status"] == REACHED for c in coverage)
+        cov = {"schema": "railproof/coverage/1", "model": self.target.rel, "goals": coverage, "reached": reached,
+               "labelled": len(coverage),
+               "unreachable_justified": sum(c["status"] == UNREACHABLE and bool(c["justification"]) for c in coverage),
+               "vectors": {k: sum(v["kind"] == k for v in all_vecs) for k in KINDS},
+               "files": {name: len(files[name][1]) for name in texts}}
+        self.out_dir.mkdir(parents=True, exist_ok=True)
+        for old in self.out_dir.glob(f"{stem}.*.jsonl"):
+            if old.name not in texts:
+                old.unlink()  # a file of a configuration no longer generated
+        for name, text in texts.items():
+            atomic_write(self.out_dir / name, text)
+        atomic_write(self.out_dir / f"{stem}.coverage.json", json.dumps(cov, indent=2, sort_keys=True) + "\n")
+        _progress(f"goal coverage {reached}/{len(coverage)} reached, {cov['unreachable_justified']} unreachable "
+                  f"justified; {len(all_vecs)} vectors written ("
+                  + ", ".join(f"{n}: {k}" for n, k in cov["files"].items()) + ")")
+        if problems:
+            raise PipelineError(f"{self.model.name}: goal coverage: " + "; ".join(problems))
+        return cov
+
+
+def generate(model: Path, params_dir: Path, spec_dir: Path, workdir: Path, out_dir: Path, walks: int = 50,
+             walk_steps: int | None = None, jobs: int = 2, part: tuple | None = None) -> dict:
+    """Generate the vectors of a model; part: (capability name, Part) instead of the registry's."""
+    capability, the_part = part if part is not None else capability_part(spec_dir, model)
+    return Generation(capability, the_part, model, params_dir, spec_dir, workdir, out_dir, walks, walk_steps,
+                      jobs).run()
 
 
 def register(sub):
     p = sub.add_parser("vectors", help="derive conformance vectors (trap goals, boundaries, random walks)")
     p.add_argument("--model", required=True)
     p.add_argument("--params", required=True, help="directory with the generated <model>_params.pml")
-    p.add_argument("--spec", required=True, help="spec/ directory (schemas, justifications)")
+    p.add_argument("--spec", required=True, help="spec/ directory (registry, schemas, justifications)")
     p.add_argument("--work", required=True)
-    p.add_argument("--out", required=True, help="output directory for <model>.jsonl and coverage")
-    p.add_argument("--walks", type=int, default=50)
-    p.add_argument("--walk-steps", type=int, default=7000,
-                   help="length of each random walk in SPIN statements (about 60 per event)")
+    p.add_argument("--out", required=True, help="output directory for <model>*.jsonl and <model>.coverage.json")
+    p.add_argument("--walks", type=int, default=50, help="random walks in the default configuration")
+    p.add_argument("--walk-steps", type=int, default=None,
+                   help="length of each random walk in SPIN statements, for models whose walks are bounded "
+                        "that way (default: the capability's)")
     p.add_argument("--jobs", type=int, default=os.cpu_count() or 1)
     p.set_defaults(func=lambda a: (generate(Path(a.model), Path(a.params), Path(a.spec), Path(a.work),
                                             Path(a.out), a.walks, a.walk_steps, a.jobs), 0)[1])

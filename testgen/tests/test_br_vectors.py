@@ -1,23 +1,21 @@
-"""Tests of the speed-supervision decision vectors (railproof_testgen.br_vectors,
-models/br.pml, spec/schemas/vectors_br.schema.json). The C++ conformance runner
-(railproof_conformance_br) is the behavioural check of the vectors; these tests check that
-they are generated, schema-valid, physically consistent and cover every goal and boundary."""
-import json
-import shutil
+"""Tests of the braking part of vector generation: the speed-supervision decision
+(railproof_testgen.capabilities.br, models/br.pml, spec/schemas/vectors_br.schema.json). The
+C++ conformance runner (railproof_conformance_br) is the behavioural check of the vectors; these
+tests check the parser and conversion on hand-made model output, and that the vectors of a build
+(RAILPROOF_RESULTS_DIR) are physically consistent and hit every boundary."""
 from pathlib import Path
 
-import jsonschema
 import pytest
-import yaml
 
-from railproof_testgen import br_vectors, spin, vectors
+from railproof_testgen import spin
+from railproof_testgen.capabilities import br
+from railproof_testgen.capabilities.br import PART
 from railproof_testgen.errors import PipelineError
+from railproof_testgen.vectors import Target
+from vector_results import vector_set
 
 REPO = Path(__file__).resolve().parents[2]
-MODEL = REPO / "models" / "braking.pml"
-SCHEMA = REPO / "spec" / "schemas" / "vectors_br.schema.json"
-needs_spin = pytest.mark.skipif(shutil.which("spin") is None or shutil.which("cc") is None,
-                                reason="spin and a C compiler are needed")
+MODEL = REPO / "models" / "br.pml"
 
 # the seeded C++ decision faults of cpp/runtime/br/src/supervisor.cpp, each mirrored by a mutant
 CPP_FAULTS = ["RESET_IGNORES_HANDLE", "RELEASE_WHILE_MOVING", "NO_RELEASE_LEAD", "EMERGENCY_LATE",
@@ -53,84 +51,52 @@ def test_parse_events_and_steps():
         _cycle(3, 0, 0, 0, [2, 1, 1, 1, 1, 0], 5, 1, 1)
         + _cycle(0, 1, 1, 1, [0, 0, 0, 0, 0, 0], 0, 0, 0)
         + ["  @IN cycle vs=1 st=0 he=0 rs=0", "  @IN p0=1"])  # cut off by the end of a trail
-    ev = br_vectors.parse_events(text)
+    ev = PART.parse_events(text)
     assert len(ev) == 2
-    steps = br_vectors.to_steps(ev)
+    steps = PART.to_steps(ev, {}, None)
     assert steps[0] == {
         "in": {"v_s": 3, "v_e": 2, "v_7n": 1, "v_6n": 1, "v_5n": 1, "v_4n": 1, "v_release": 0,
                "standstill": False, "handle_emergency": False, "reset": False},
         "out": {"level": "EB", "pattern_approaching": True, "emergency_latched": True}}
     assert steps[1]["in"]["standstill"] and steps[1]["out"]["level"] == "NONE"
-    assert br_vectors.observed_requirements(steps) == {"REQ-BR-001", "REQ-BR-003", "REQ-BR-006"}
+    assert PART.observed_requirements(steps) == {"REQ-BR-001", "REQ-BR-003", "REQ-BR-006"}
 
 
 def test_output_without_complete_inputs_is_an_error():
     with pytest.raises(PipelineError, match="without a complete @IN cycle"):
-        br_vectors.parse_events("@IN cycle vs=1 st=0 he=0 rs=0\n@IN p0=1\n@OUT level=0 appr=0 latched=0")
+        PART.parse_events("@IN cycle vs=1 st=0 he=0 rs=0\n@IN p0=1\n@OUT level=0 appr=0 latched=0")
     with pytest.raises(PipelineError, match="unrecognised"):
-        br_vectors.parse_events("@OUT tx seq=1")
+        PART.parse_events("@OUT tx seq=1")
 
 
-@pytest.fixture(scope="module")
-def generated(tmp_path_factory):
-    if shutil.which("spin") is None or shutil.which("cc") is None:
-        pytest.skip("spin and a C compiler are needed")
-    tmp = tmp_path_factory.mktemp("br")
-    params = tmp / "params"
-    params.mkdir()
-    # the model bounds of spec/parameters/br.yaml, as gen-params writes them
-    data = yaml.safe_load((REPO / "spec" / "parameters" / "braking.yaml").read_text(encoding="utf-8"))
-    (params / "br_params.pml").write_text(
-        "".join(f"#define {e['id'].upper()} {e['value']}\n" for e in data["model_bounds"]), encoding="utf-8")
-    out = tmp / "vectors"
-    cov = vectors.generate(MODEL, params, REPO / "spec", tmp / "work", out, walks=4, jobs=2)
-    lines = [json.loads(ln) for ln in (out / "braking.jsonl").read_text(encoding="utf-8").splitlines()]
-    return cov, lines, out, spin.read_bounds(params / "br_params.pml")
+def test_header_records_units_and_bounds():
+    h = PART.header(Target(MODEL, spin.parse_annotations(MODEL), {"vmax": 9, "cycles": 6}, "test"), None)
+    assert h["configuration"] == "default" and h["units"] == br.UNITS == "abstract speed units = mm/s"
+    assert h["parameters"] == {"model_vmax": 9, "model_cycles": 6, "levels": br.LEVELS}
+    assert h["model"] == "models/br.pml" and h["model_sha256"] == spin.sha256_file(MODEL)
 
 
-@needs_spin
-def test_vectors_are_schema_valid_and_cover_every_goal(generated):
-    cov, lines, out, bounds = generated
-    validator = jsonschema.Draft202012Validator(json.loads(SCHEMA.read_text(encoding="utf-8")))
-    for n, obj in enumerate(lines, 1):
-        assert not list(validator.iter_errors(obj)), f"line {n}"
-    header, vecs = lines[0], lines[1:]
-    assert header["kind"] == "header" and header["model"] == "models/br.pml"
-    assert header["units"] == "abstract speed units = mm/s"
-    assert header["model_sha256"] == spin.sha256_file(MODEL)
-    ann = spin.parse_annotations(MODEL)
-    assert cov["labelled"] == len(ann.goals)
-    ids = {v["id"] for v in vecs}
-    assert len(ids) == len(vecs)
-    for g in cov["goals"]:  # reached with a vector, or justified
-        if g["status"] == "reached":
-            assert g["vectors"] and set(g["vectors"]) <= ids
-        else:
-            assert g["justification"], g
-    assert cov["reached"] == len(ann.goals)  # every branch of the decision is reachable
-    assert sum(v["kind"] == "random" for v in vecs) == 4
-    on_disk = json.loads((out / "braking.coverage.json").read_text(encoding="utf-8"))
-    assert on_disk["reached"] == cov["reached"]
-
-
-@needs_spin
-def test_vectors_are_consistent_and_hit_every_boundary(generated):
-    _cov, lines, _out, bounds = generated
-    vmax = bounds["vmax"]
-    steps = [s for v in lines[1:] for s in v["steps"]]
+def test_vectors_are_consistent_and_hit_every_boundary():
+    vs = vector_set("br")
+    vecs = vs.vectors("br.jsonl")
+    assert set(vs.files) == {"br.jsonl"} and vs.coverage["reached"] == vs.coverage["labelled"]  # every branch
+    vmax = vs.header("br.jsonl")["parameters"]["model_vmax"]
+    cycles = vs.header("br.jsonl")["parameters"]["model_cycles"]
+    assert all(len(v["steps"]) == cycles for v in vecs if v["kind"] == "random")
+    steps = [s for v in vecs for s in v["steps"]]
     for s in steps:
         i = s["in"]
-        assert all(0 <= i[k] <= vmax for k in ("v_s", *br_vectors.PATTERNS))
+        assert all(0 <= i[k] <= vmax for k in ("v_s", *br.PATTERNS))
         assert not i["standstill"] or i["v_s"] == 0  # standstill implies v_s = 0
         assert s["out"]["level"] != "EB" or s["out"]["emergency_latched"]
-    for p in br_vectors.PATTERNS:  # v_s exactly at and one above every pattern speed
+    for p in br.PATTERNS:  # v_s exactly at and one above every pattern speed
         assert any(s["in"]["v_s"] == s["in"][p] and s["in"]["v_s"] > 0 for s in steps), p
         assert any(s["in"]["v_s"] == s["in"][p] + 1 for s in steps), p
     # the emergency boundary vector: EB at v_e + 1 in a cycle without a latch
-    g5 = next(v for v in lines[1:] if v["goal"] == "G5")
+    g5 = vs.by_goal("br.jsonl")["G5"]
     last = g5["steps"][-1]
     assert last["in"]["v_s"] == last["in"]["v_e"] + 1 and last["out"]["level"] == "EB"
     # every latch-release condition is missing alone in some vector, with the EB held
-    held = [s["in"] for v in lines[1:] if v["goal"] in ("G0", "G1", "G2") for s in v["steps"][-1:]]
+    held = [s["in"] for v in vecs if v["goal"] in ("G0", "G1", "G2") for s in v["steps"][-1:]]
     assert sorted((i["standstill"], i["handle_emergency"], i["reset"]) for i in held) == [
         (False, True, True), (True, False, True), (True, True, False)]

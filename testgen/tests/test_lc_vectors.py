@@ -1,26 +1,25 @@
-"""Tests of the level-crossing vectors (railproof_testgen.lc_vectors, models/lc.pml,
-spec/schemas/vectors_lc.schema.json). The C++ conformance runner
-(railproof_conformance_lc) is the behavioural check of the vectors; these tests check that they
-are parsed, converted to absolute times and C++ units, schema-checked, generated for every
-configuration, consistent with design note §3-§5 and cover every goal (or justify it)."""
+"""Tests of the level-crossing part of vector generation (railproof_testgen.capabilities.lc,
+models/lc.pml, spec/schemas/vectors_lc.schema.json). The C++ conformance runner
+(railproof_conformance_lc) is the behavioural check of the vectors; these tests check the parser,
+the conversion to absolute times and C++ units, the ETA classes, header and schema on hand-made
+model output, and that the vectors of a build (RAILPROOF_RESULTS_DIR) have a file per
+configuration, follow design note §3-§5 and hit the boundaries."""
 import copy
 import json
 import re
-import shutil
 from pathlib import Path
 
-import jsonschema
 import pytest
-import yaml
 
-from railproof_testgen import lc_vectors, spin, vectors
+from railproof_testgen import spin, vectors
+from railproof_testgen.capabilities import lc
+from railproof_testgen.capabilities.lc import PART
 from railproof_testgen.errors import PipelineError
+from vector_results import vector_set
 
 REPO = Path(__file__).resolve().parents[2]
-MODEL = REPO / "models" / "level_crossing.pml"
+MODEL = REPO / "models" / "lc.pml"
 SCHEMA = REPO / "spec" / "schemas" / "vectors_lc.schema.json"
-needs_spin = pytest.mark.skipif(shutil.which("spin") is None or shutil.which("cc") is None,
-                                reason="spin and a C compiler are needed")
 
 # the seeded C++ faults of cpp/runtime/lc/src/onboard/crossing_protection.cpp, cpp/runtime/lc/src/wayside/crossing_controller.cpp
 # and cpp/runtime/lc/src/wayside/centre_scheduler.cpp, each mirrored by a mutant of the same name
@@ -57,13 +56,13 @@ def test_annotations_of_the_level_crossing_model():
         assert m.violates in props and m.config in props[m.violates].configs, m.name
     assert len({g.number for g in ann.goals}) == len(ann.goals)
     assert all(g.requirements and g.label for g in ann.goals)
-    assert {g.config for g in ann.goals} <= set(lc_vectors.CONFIGS)
-    assert {g.config for g in ann.goals} == set(lc_vectors.CONFIGS)  # every file gets trap vectors
+    # every file gets trap vectors
+    assert {g.config for g in ann.goals} == {c.define for c in PART.configurations}
 
 
 def test_model_local_bounds_are_read_from_the_model():
-    local = lc_vectors.model_local_defaults(MODEL)
-    assert set(local) | {"dwell_ticks"} == set(lc_vectors.LOCAL)
+    local = lc.model_local_defaults(MODEL)
+    assert set(local) | {"dwell_ticks"} == set(lc.LOCAL)
     assert local["conf_age_ticks"] == 0 and local["lead_ticks"] >= 1 and local["gnss_faults"] >= 1
 
 
@@ -84,13 +83,13 @@ def test_eta_classes_match_the_cpp_rounding():
     tick length (design §2 rounding; the generator asserts the same on every vector)."""
     for d in range(0, 2 * BOUNDS["track"] + 1):
         for v in range(0, BOUNDS["vmax"] + 1):
-            ms = lc_vectors.eta_ms(d * lc_vectors.HALF_MM, v * lc_vectors.SPEED_MM_S, lc_vectors.ACCEL_MM_S2,
-                                   BOUNDS["vmax"] * lc_vectors.SPEED_MM_S)
-            assert lc_vectors.eta_class(ms) == _model_eta2(d, v), (d, v, ms)
+            ms = lc.eta_ms(d * lc.HALF_MM, v * lc.SPEED_MM_S, lc.ACCEL_MM_S2,
+                                   BOUNDS["vmax"] * lc.SPEED_MM_S)
+            assert lc.eta_class(ms) == _model_eta2(d, v), (d, v, ms)
     # e.g. 4 cells from rest: accelerate 2 ticks, 2 cells at speed 2: exactly 3 ticks
-    assert lc_vectors.eta_ms(4 * lc_vectors.CELL_MM, 0, lc_vectors.ACCEL_MM_S2, 2 * lc_vectors.SPEED_MM_S) == 30_000
+    assert lc.eta_ms(4 * lc.CELL_MM, 0, lc.ACCEL_MM_S2, 2 * lc.SPEED_MM_S) == 30_000
     with pytest.raises(PipelineError, match="ETA class"):
-        lc_vectors.check_eta(0, 0, 0, 16, 9, BOUNDS, "test")
+        lc.check_eta(0, 0, 0, 16, 9, BOUNDS, "test")
 
 
 ONBOARD_RUN = """spin: unrelated
@@ -142,13 +141,13 @@ GNSS_RUN = """@IN tick t=0 x=8 v=0 ph=1 dw=2
 
 
 def test_parse_and_convert_onboard_ticks():
-    ticks = lc_vectors.parse_events(ONBOARD_RUN)
+    ticks = PART.parse_events(ONBOARD_RUN)
     assert len(ticks) == 2  # the third tick is cut off by the end of the trail
     assert ticks[1]["ul"] == [{"c": 0, "age": 0, "m": 1}]
     assert ticks[1]["rx"] == [{"c": 0, "age": 1}, {"c": 0, "age": 0}]
-    steps = lc_vectors.to_steps(ticks, BOUNDS, None)
+    steps = PART.to_steps(ticks, BOUNDS, None)
     s0, s1 = steps
-    assert s0["t_ms"] == 0 and s1["t_ms"] == lc_vectors.TICK_MS
+    assert s0["t_ms"] == 0 and s1["t_ms"] == lc.TICK_MS
     assert s0["train"] == {"front_mm": 0, "speed_mm_s": 0, "dwell": False, "departure_ms": 0}
     assert s1["train"]["front_mm"] == 50_000 and s1["train"]["speed_mm_s"] == 10_000
     c0 = s1["controllers"][0]
@@ -163,13 +162,13 @@ def test_parse_and_convert_onboard_ticks():
     out = s0["onboard"]["out"]
     assert out["states"] == ["REQUESTED", "REQUESTED"] and out["eta_half_ticks"] == [10, 12]
     assert out["requests"] == [1, 2] and out["withdrawals"] == [] and out["stop_limit_mm"] == 14 * 50_000
-    assert lc_vectors.observed_requirements(steps) >= {"REQ-LC-001", "REQ-LC-002", "REQ-LC-003", "REQ-LC-006"}
+    assert PART.observed_requirements(steps) >= {"REQ-LC-001", "REQ-LC-002", "REQ-LC-003", "REQ-LC-006"}
 
 
 def test_parse_and_convert_gnss_ticks():
-    steps = lc_vectors.to_steps(lc_vectors.parse_events(GNSS_RUN), BOUNDS, "GNSS")
+    steps = PART.to_steps(PART.parse_events(GNSS_RUN), BOUNDS, "GNSS")
     s0, s1 = steps
-    t = lc_vectors.timing(BOUNDS, "GNSS")
+    t = lc.timing(BOUNDS, "GNSS")
     assert t["OFS"] == 6
     ce = s0["centre"]
     # the standing train's report: front and rear on whole cells, speed bound 0 at the station
@@ -194,24 +193,22 @@ def test_parse_and_convert_gnss_ticks():
 
 def test_malformed_model_output_is_an_error():
     with pytest.raises(PipelineError, match="unrecognised"):
-        lc_vectors.parse_events("@OUT level=1 appr=0 latched=0")
+        PART.parse_events("@OUT level=1 appr=0 latched=0")
     with pytest.raises(PipelineError, match="outside a tick"):
-        lc_vectors.parse_events("@OUT ctrl c=0 cs=0 wa=0 new=0 ack=0 rq=0")
+        PART.parse_events("@OUT ctrl c=0 cs=0 wa=0 new=0 ack=0 rq=0")
     bad = ONBOARD_RUN.replace("@OUT ctrl c=0 cs=1 wa=0 new=1 ack=0 rq=1", "@OUT ctrl c=0 cs=1 wa=0 new=1 ack=0 rq=0")
     with pytest.raises(PipelineError, match="requester tracking"):
-        lc_vectors.to_steps(lc_vectors.parse_events(bad), BOUNDS, None)
+        PART.to_steps(PART.parse_events(bad), BOUNDS, None)
     bad = ONBOARD_RUN.replace("e0=8 e1=10", "e0=7 e1=10")
     with pytest.raises(PipelineError, match="ETA class"):
-        lc_vectors.to_steps(lc_vectors.parse_events(bad), BOUNDS, None)
+        PART.to_steps(PART.parse_events(bad), BOUNDS, None)
     bad = GNSS_RUN.replace("@OUT centre clr=0 st0=10 p0=0 a0=1", "@OUT centre clr=1 st0=10 p0=0 a0=1")
     with pytest.raises(PipelineError, match="departure signal"):
-        lc_vectors.to_steps(lc_vectors.parse_events(bad), BOUNDS, "GNSS")
+        PART.to_steps(PART.parse_events(bad), BOUNDS, "GNSS")
 
 
 def _header(config=None):
-    h = lc_vectors.header_for(MODEL, BOUNDS, config)
-    h["spin_version"] = "test"
-    return h
+    return PART.header(vectors.Target(MODEL, spin.parse_annotations(MODEL), BOUNDS, "test"), config)
 
 
 def test_header_records_the_configuration_and_units():
@@ -225,20 +222,20 @@ def test_header_records_the_configuration_and_units():
     assert p["controller"]["barrier_timeout_ms"] == 20_000 and hl["parameters"]["controller"]["barrier_timeout_ms"] == 30_000
     assert p["restrictions"] == [{"begin_mm": 0, "end_mm": 1_400_000, "limit_mm_s": 20_000}]
     assert "departure" not in p and hg["parameters"]["departure"]["departure_ms"] == 20_000
-    assert h["unit_scales"]["mm_s2_per_accel_unit"] == 1000 and h["units"] == lc_vectors.UNITS
+    assert h["unit_scales"]["mm_s2_per_accel_unit"] == 1000 and h["units"] == lc.UNITS
 
 
 def _vector(config=None, run=ONBOARD_RUN, vid="LC-TRAP-G0"):
-    steps = lc_vectors.to_steps(lc_vectors.parse_events(run), BOUNDS, config)
+    steps = PART.to_steps(PART.parse_events(run), BOUNDS, config)
     return {"id": vid, "requirements": ["REQ-LC-002"], "goal": "G0", "kind": "trap", "seed": None, "steps": steps}
 
 
 def test_schema_accepts_good_and_rejects_bad_records():
     good = [_header(), _vector()]
-    text = vectors.schema_checked_jsonl(SCHEMA, good, "level_crossing.jsonl")
+    text = vectors.schema_checked_jsonl(SCHEMA, good, "lc.jsonl")
     assert [json.loads(ln) for ln in text.splitlines()] == good
     vectors.schema_checked_jsonl(SCHEMA, [_header("GNSS"), _vector("GNSS", GNSS_RUN, "LC-TRAP-GNSS-G60")],
-                                 "level_crossing.gnss.jsonl")
+                                 "lc.gnss.jsonl")
 
     def broken(edit):
         lines = copy.deepcopy(good)
@@ -264,83 +261,38 @@ def test_schema_accepts_good_and_rejects_bad_records():
     }
     for what, edit in cases.items():
         with pytest.raises(PipelineError, match="violates the vector schema"):
-            vectors.schema_checked_jsonl(SCHEMA, broken(edit), "level_crossing.jsonl")
+            vectors.schema_checked_jsonl(SCHEMA, broken(edit), "lc.jsonl")
             pytest.fail(f"schema accepted: {what}")
     # the message names the field inside the vector (not the whole line) and stays short
     no_list = broken(lambda ls: ls[1]["steps"][0]["onboard"]["in"]["reports"][0].pop("requesters"))
     with pytest.raises(PipelineError) as info:
-        vectors.schema_checked_jsonl(SCHEMA, no_list, "level_crossing.jsonl")
+        vectors.schema_checked_jsonl(SCHEMA, no_list, "lc.jsonl")
     assert "'requesters' is a required property" in str(info.value)
     assert re.search(r"line 2 violates the vector schema: steps/0/\S*reports?\S*: ", str(info.value)), info.value
     assert len(str(info.value)) < 500
 
 
-FILES = ["level_crossing.jsonl", "level_crossing.long_warning.jsonl", "level_crossing.two_trains.jsonl",
-         "level_crossing.gnss.jsonl", "level_crossing.gnss_clock.jsonl"]
+def test_every_configuration_has_its_file():
+    vs = vector_set("lc")
+    assert sorted(vs.files) == sorted(f"lc{c.suffix}.jsonl" for c in PART.configurations)
+    for c in PART.configurations:
+        name = f"lc{c.suffix}.jsonl"
+        header = vs.header(name)
+        assert header["configuration"] == c.name and header["variant"] == lc.VARIANT[c.define][0]
+        walks = [v for v in vs.vectors(name) if v["kind"] == "random"]
+        assert walks and all(len(v["steps"]) == PART.walk_length(header["parameters"]["model_bounds"], c.define)
+                             for v in walks)
+        for v in vs.vectors(name):
+            assert v["id"].startswith(f"LC-{v['kind'].upper()}-{c.tag}"), v["id"]
+    goals = {g["id"]: g for g in vs.coverage["goals"]}
+    assert all(g["configuration"] in {c.name for c in PART.configurations} for g in goals.values())
 
 
-@pytest.fixture(scope="module")
-def generated(tmp_path_factory):
-    if shutil.which("spin") is None or shutil.which("cc") is None:
-        pytest.skip("spin and a C compiler are needed")
-    tmp = tmp_path_factory.mktemp("lc")
-    params = tmp / "params"
-    params.mkdir()
-    # the model bounds of spec/parameters/lc.yaml, as gen-params writes them
-    data = yaml.safe_load((REPO / "spec" / "parameters" / "level_crossing.yaml").read_text(encoding="utf-8"))
-    (params / "lc_params.pml").write_text(
-        "".join(f"#define {e['id'].upper()} {e['value']}\n" for e in data["model_bounds"]), encoding="utf-8")
-    out = tmp / "vectors"
-    out.mkdir()
-    (out / "level_crossing.stale.jsonl").write_text("{}\n", encoding="utf-8")  # an earlier run's file
-    cov = vectors.generate(MODEL, params, REPO / "spec", tmp / "work", out, walks=5, jobs=2)
-    files = {name: [json.loads(ln) for ln in (out / name).read_text(encoding="utf-8").splitlines()] for name in FILES}
-    b = lc_vectors.all_bounds(MODEL, params / "lc_params.pml")
-    return cov, files, out, b
-
-
-@needs_spin
-def test_vectors_are_schema_valid_and_cover_every_goal(generated):
-    cov, files, out, _b = generated
-    assert sorted(p.name for p in out.glob("*.jsonl")) == sorted(FILES)
-    validator = jsonschema.Draft202012Validator(json.loads(SCHEMA.read_text(encoding="utf-8")))
-    ids = set()
-    for name, lines in files.items():
-        for n, obj in enumerate(lines, 1):
-            assert not list(validator.iter_errors(obj)), f"{name} line {n}"
-        header = lines[0]
-        assert header["model"] == "models/lc.pml" and header["model_sha256"] == spin.sha256_file(MODEL)
-        cfg = next(c for c, v in lc_vectors.CONFIGS.items() if f"level_crossing{v[0]}.jsonl" == name)
-        assert header["configuration"] == (cfg or "default")
-        assert len(lines) > 1
-        for v in lines[1:]:
-            assert v["id"] not in ids
-            ids.add(v["id"])
-            assert v["id"].startswith(f"LC-{v['kind'].upper()}-{lc_vectors.CONFIGS[cfg][1]}")
-    ann = spin.parse_annotations(MODEL)
-    assert cov["labelled"] == len(ann.goals)
-    jfile = REPO / "spec" / "justifications" / "level_crossing.yaml"
-    justified = {}
-    if jfile.exists():
-        justified = {j["goal"]: j["id"] for j in yaml.safe_load(jfile.read_text())["justifications"]}
-    for g in cov["goals"]:  # reached with a vector, or justified
-        if g["status"] == "reached":
-            assert g["vectors"] and set(g["vectors"]) <= ids
-        else:
-            assert g["justification"] == justified[g["id"]], g
-    assert cov["reached"] + cov["unreachable_justified"] == len(ann.goals)
-    assert sum(v["kind"] == "random" for v in files["level_crossing.jsonl"][1:]) == 5
-    assert cov["files"] == {n: len(lines) - 1 for n, lines in files.items()}
-    on_disk = json.loads((out / "level_crossing.coverage.json").read_text(encoding="utf-8"))
-    assert on_disk["reached"] == cov["reached"]
-
-
-@needs_spin
-def test_vectors_follow_the_design_note(generated):
+def test_vectors_follow_the_design_note():
     """Invariants of design note §3-§5 on every step of every vector (the exact values are the
     C++ conformance runner's check)."""
-    _cov, files, _out, b = generated
-    for name, lines in files.items():
+    vs = vector_set("lc")
+    for name, lines in vs.files.items():
         h = lines[0]["parameters"]
         near = {c["id"]: c["near_mm"] for c in h["crossings"]}
         offset = h["protection"]["protection_offset_mm"]
@@ -351,7 +303,7 @@ def test_vectors_follow_the_design_note(generated):
                 prev_t = s["t_ms"]
                 for c in s["controllers"]:
                     o = c["out"]
-                    assert o["report"]["status"] == lc_vectors.STATUS_OF[o["state"]]
+                    assert o["report"]["status"] == lc.STATUS_OF[o["state"]]
                     assert o["report"]["issued_ms"] == s["t_ms"]
                     assert o["lights_on"] == (o["state"] != "OPEN")
                     assert (o["failure"] != "NONE") == (o["state"] == "FAILED")
@@ -384,11 +336,10 @@ def test_vectors_follow_the_design_note(generated):
                         assert pos["time_ms"] <= s["t_ms"] and pos["rear_mm"] < pos["front_mm"]
 
 
-@needs_spin
-def test_boundary_vectors_hit_the_boundaries(generated):
-    _cov, files, _out, b = generated
-    t = lc_vectors.timing(b, None)
-    vecs = {v["goal"]: v for v in files["level_crossing.jsonl"][1:] if v["goal"]}
+def test_boundary_vectors_hit_the_boundaries():
+    vs = vector_set("lc")
+    t = lc.timing(vs.header("lc.jsonl")["parameters"]["model_bounds"], None)
+    vecs = vs.by_goal("lc.jsonl")
     last = {g: v["steps"][-1] for g, v in vecs.items()}
     # G0/G1: the request exactly at ETA = W + LEAD, none half a tick above
     assert last["G0"]["onboard"]["out"]["states"][0] == "REQUESTED"
@@ -414,12 +365,12 @@ def test_boundary_vectors_hit_the_boundaries(generated):
     assert s["onboard"]["out"]["states"][0] == "PASSED" and s["onboard"]["out"]["withdrawals"] == [1]
     assert s["train"]["front_mm"] - 100_000 == 900_000
     # LONG_WARNING G4: CLOSED for the train but warned too short: no clearance
-    lw = {v["goal"]: v for v in files["level_crossing.long_warning.jsonl"][1:] if v["goal"]}
+    lw = vs.by_goal("lc.long_warning.jsonl")
     s = lw["G4"]["steps"][-1]
     assert s["onboard"]["out"]["states"][0] == "REQUESTED"
     assert any(r["status"] == "CLOSED" for r in s["onboard"]["in"]["reports"])
     # GNSS G60: autonomous start exactly at the stored start time
-    gv = {v["goal"]: v for v in files["level_crossing.gnss.jsonl"][1:] if v["goal"]}
+    gv = vs.by_goal("lc.gnss.jsonl")
     s = gv["G60"]["steps"][-1]["controllers"][0]
     assert s["out"]["state"] == "WARNING" and s["out"]["pending"]["start_ms"] == gv["G60"]["steps"][-1]["t_ms"]
     # GNSS G100: the train leaves exactly at t_dep on the signal

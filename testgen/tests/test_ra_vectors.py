@@ -1,25 +1,24 @@
-"""Tests of the re-adhesion state machine vectors (railproof_testgen.ra_vectors,
-models/ra.pml, spec/schemas/vectors_ra.schema.json). The C++ conformance
-runner (railproof_conformance_ra) is the behavioural check of the vectors; these tests check
-that they are parsed, converted, schema-checked, generated for both machine configurations,
-consistent with design note §5 and cover every goal (or justify it)."""
+"""Tests of the re-adhesion part of vector generation: the state machine
+(railproof_testgen.capabilities.ra, models/ra.pml, spec/schemas/vectors_ra.schema.json). The C++
+conformance runner (railproof_conformance_ra) is the behavioural check of the vectors; these
+tests check the parser, conversion, header and schema on hand-made model output, and that the
+vectors of a build (RAILPROOF_RESULTS_DIR) cover both machine configurations, follow design
+note §5 and hit the boundaries."""
 import copy
 import json
-import shutil
 from pathlib import Path
 
-import jsonschema
 import pytest
-import yaml
 
-from railproof_testgen import ra_vectors, spin, vectors
+from railproof_testgen import spin, vectors
+from railproof_testgen.capabilities import ra
+from railproof_testgen.capabilities.ra import PART
 from railproof_testgen.errors import PipelineError
+from vector_results import vector_set
 
 REPO = Path(__file__).resolve().parents[2]
-MODEL = REPO / "models" / "readhesion.pml"
+MODEL = REPO / "models" / "ra.pml"
 SCHEMA = REPO / "spec" / "schemas" / "vectors_ra.schema.json"
-needs_spin = pytest.mark.skipif(shutil.which("spin") is None or shutil.which("cc") is None,
-                                reason="spin and a C compiler are needed")
 
 # the seeded C++ faults of cpp/runtime/ra/src/readhesion_machine.cpp, each mirrored by a mutant
 CPP_FAULTS = ["TIMEOUT_OFF_BY_ONE", "CONFIRM_TWO", "SPEED_IGNORED", "EPISODE_RELAXES", "LAST_CANDIDATE_WINS",
@@ -42,7 +41,7 @@ def test_annotations_of_the_readhesion_model():
                        "REQ-RA-013"}
     # the one-start-point configuration: a variant, so every property is verified in it too
     assert [(v.define, v.parameter, v.bound) for v in ann.variants] == [("ONE_START", "start_points", "1")]
-    assert set(ra_vectors.CONFIGS) == {None, "ONE_START"}
+    assert [c.define for c in PART.configurations] == [None, "ONE_START"]
     mutants = {m.name: m for m in ann.mutants}
     assert {f"MUTANT_{f}" for f in CPP_FAULTS} <= set(mutants)
     assert len(mutants) > len(CPP_FAULTS)
@@ -69,11 +68,11 @@ def test_parse_events_and_steps():
         + _cycle(sa=(1, 0), sec=2, mode=0, tmax=6, margin=3, adopted=0)
         + _cycle(imu=0, tg=0, bal=1, mode=2, reason=2, tmax=9, stop=1, valid=0)
         + ["  @IN cycle dev=0 sa0=0 sa1=0 imu=1 tg=1 bal=0 sec=0 age=2"])  # cut off by the end of a trail
-    ev = ra_vectors.parse_events(text)
+    ev = PART.parse_events(text)
     assert len(ev) == 3
     assert ev[0][0] == {"dev": True, "sa": [False, False], "imu": True, "tg": True, "bal": False, "sec": 1,
                         "age": 3}
-    steps = ra_vectors.to_steps(ev, BOUNDS)
+    steps = PART.to_steps(ev, BOUNDS, None)
     assert steps[0] == {
         "in": {"deviation": True, "speed_agrees": [False, False], "imu_ok": True, "tg_ok": True, "balise": False,
                "section": {"kind": "STEEP", "max_compensation_cycles": 9, "margin_mm": 3},
@@ -88,31 +87,29 @@ def test_parse_events_and_steps():
     assert steps[1]["out"]["adopted"] == 0 and steps[1]["out"]["mode"] == "TG"
     assert steps[2]["out"]["stop_reason"] == "IMU_FAILURE" and steps[2]["out"]["stop_demand"]
     assert not steps[2]["in"]["imu_ok"] and steps[2]["in"]["balise"]
-    assert ra_vectors.observed_requirements(steps) == {"REQ-RA-003", "REQ-RA-004", "REQ-RA-006", "REQ-RA-009", "REQ-RA-010",
+    assert PART.observed_requirements(steps) == {"REQ-RA-003", "REQ-RA-004", "REQ-RA-006", "REQ-RA-009", "REQ-RA-010",
                                                         "REQ-RA-013"}
-    assert ra_vectors.observed_requirements([]) == set()
+    assert PART.observed_requirements([]) == set()
 
 
 def test_malformed_model_output_is_an_error():
     with pytest.raises(PipelineError, match="without its @IN cycle"):
-        ra_vectors.parse_events(_cycle()[1])
+        PART.parse_events(_cycle()[1])
     with pytest.raises(PipelineError, match="unrecognised"):
-        ra_vectors.parse_events("@OUT level=1 appr=0 latched=0")
+        PART.parse_events("@OUT level=1 appr=0 latched=0")
     with pytest.raises(PipelineError, match="unknown adopted"):
-        ra_vectors.to_steps(ra_vectors.parse_events("\n".join(_cycle(adopted=7))), BOUNDS)
+        PART.to_steps(PART.parse_events("\n".join(_cycle(adopted=7))), BOUNDS, None)
     with pytest.raises(PipelineError, match="outside the known"):
-        ra_vectors.to_steps(ra_vectors.parse_events("\n".join(_cycle(sec=3))), BOUNDS)
+        PART.to_steps(PART.parse_events("\n".join(_cycle(sec=3))), BOUNDS, None)
 
 
 def _header(config=None):
-    h = ra_vectors.header_for(MODEL, BOUNDS, config)
-    h["spin_version"] = "test"
-    return h
+    return PART.header(vectors.Target(MODEL, spin.parse_annotations(MODEL), BOUNDS, "test"), config)
 
 
 def _vector():
-    steps = ra_vectors.to_steps(ra_vectors.parse_events("\n".join(
-        _cycle(dev=1, mode=1, a0=1, t0=2, a1=1, t1=4, det=1))), BOUNDS)
+    steps = PART.to_steps(PART.parse_events("\n".join(
+        _cycle(dev=1, mode=1, a0=1, t0=2, a1=1, t1=4, det=1))), BOUNDS, None)
     return {"id": "RA-TRAP-G0", "requirements": ["REQ-RA-003"], "goal": "G0", "kind": "trap", "seed": None,
             "steps": steps}
 
@@ -123,16 +120,16 @@ def test_header_records_the_machine_configuration():
     assert h["parameters"]["start_points"] == 2 and h1["parameters"]["start_points"] == 1
     assert h["parameters"]["confirm_cycles"] == 3 and h["parameters"]["spacing_cycles"] == 2
     assert h["parameters"]["start_age_cycles"] == [2, 3]
-    assert h["units"] == ra_vectors.UNITS == "model ticks = cycles, model margin units = mm"
-    assert [s["kind"] for s in h["parameters"]["sections"]] == ra_vectors.SECTIONS
+    assert h["units"] == ra.UNITS == "model ticks = cycles, model margin units = mm"
+    assert [s["kind"] for s in h["parameters"]["sections"]] == ra.SECTIONS
 
 
-def test_schema_accepts_good_and_rejects_bad_records(tmp_path):
+def test_schema_accepts_good_and_rejects_bad_records():
     good = [_header(), _vector()]
-    text = vectors.schema_checked_jsonl(SCHEMA, good, "readhesion.jsonl")
+    text = vectors.schema_checked_jsonl(SCHEMA, good, "ra.jsonl")
     assert [json.loads(ln) for ln in text.splitlines()] == good
     vectors.schema_checked_jsonl(SCHEMA, [_header("ONE_START"), {**_vector(), "id": "RA-TRAP-ONESTART-G0"}],
-                                 "readhesion.one_start.jsonl")
+                                 "ra.one_start.jsonl")
 
     def broken(edit):
         lines = copy.deepcopy(good)
@@ -158,76 +155,37 @@ def test_schema_accepts_good_and_rejects_bad_records(tmp_path):
     }
     for what, edit in cases.items():
         with pytest.raises(PipelineError, match="violates the vector schema"):
-            vectors.schema_checked_jsonl(SCHEMA, broken(edit), "readhesion.jsonl")
+            vectors.schema_checked_jsonl(SCHEMA, broken(edit), "ra.jsonl")
             pytest.fail(f"schema accepted: {what}")
 
 
-@pytest.fixture(scope="module")
-def generated(tmp_path_factory):
-    if shutil.which("spin") is None or shutil.which("cc") is None:
-        pytest.skip("spin and a C compiler are needed")
-    tmp = tmp_path_factory.mktemp("ra")
-    params = tmp / "params"
-    params.mkdir()
-    # the model bounds of spec/parameters/ra.yaml, as gen-params writes them
-    data = yaml.safe_load((REPO / "spec" / "parameters" / "readhesion.yaml").read_text(encoding="utf-8"))
-    (params / "ra_params.pml").write_text(
-        "".join(f"#define {e['id'].upper()} {e['value']}\n" for e in data["model_bounds"]), encoding="utf-8")
-    out = tmp / "vectors"
-    out.mkdir()
-    (out / "readhesion.stale.jsonl").write_text("{}\n", encoding="utf-8")  # an earlier run's file
-    cov = vectors.generate(MODEL, params, REPO / "spec", tmp / "work", out, walks=5, jobs=2)
-    files = {}
-    for name in ("readhesion.jsonl", "readhesion.one_start.jsonl"):
-        files[name] = [json.loads(ln) for ln in (out / name).read_text(encoding="utf-8").splitlines()]
-    return cov, files, out, spin.read_bounds(params / "ra_params.pml")
-
-
-@needs_spin
-def test_vectors_are_schema_valid_and_cover_every_goal(generated):
-    cov, files, out, _bounds = generated
-    assert sorted(p.name for p in out.glob("*.jsonl")) == ["readhesion.jsonl", "readhesion.one_start.jsonl"]
-    validator = jsonschema.Draft202012Validator(json.loads(SCHEMA.read_text(encoding="utf-8")))
-    ids = set()
-    for name, lines in files.items():
-        for n, obj in enumerate(lines, 1):
-            assert not list(validator.iter_errors(obj)), f"{name} line {n}"
-        header = lines[0]
-        assert header["model"] == "models/ra.pml" and header["model_sha256"] == spin.sha256_file(MODEL)
-        one = name == "readhesion.one_start.jsonl"
+def test_both_machine_configurations_have_their_file():
+    vs = vector_set("ra")
+    assert sorted(vs.files) == ["ra.jsonl", "ra.one_start.jsonl"]
+    for name in vs.files:
+        one = name == "ra.one_start.jsonl"
+        header = vs.header(name)
         assert header["configuration"] == ("ONE_START" if one else "default")
         assert header["parameters"]["start_points"] == (1 if one else 2)
-        for v in lines[1:]:
-            assert v["id"] not in ids
-            ids.add(v["id"])
-            assert ("ONESTART-" in v["id"]) == one
-    ann = spin.parse_annotations(MODEL)
-    assert cov["labelled"] == len(ann.goals)
-    jfile = REPO / "spec" / "justifications" / "readhesion.yaml"  # none while every goal is reached
-    justifications = yaml.safe_load(jfile.read_text()) if jfile.is_file() else {"justifications": []}
-    justified = {j["goal"]: j["id"] for j in justifications["justifications"]}
-    for g in cov["goals"]:  # reached with a vector, or justified
-        if g["status"] == "reached":
-            assert g["vectors"] and set(g["vectors"]) <= ids
-        else:
-            assert g["justification"] == justified[g["id"]], g
-        assert set(g.get("variant_vectors", [])) <= ids
-    assert cov["reached"] + cov["unreachable_justified"] == len(ann.goals)
-    one_start = [g for g in cov["goals"] if g["configuration"] == "ONE_START"]
+        assert all(("ONESTART-" in v["id"]) == one for v in vs.vectors(name))
+        assert any(v["kind"] == "random" for v in vs.vectors(name))
+        assert all(len(v["steps"]) == header["parameters"]["model_cycles"] for v in vs.vectors(name)
+                   if v["kind"] == "random")
+    goals = vs.coverage["goals"]
+    one_start = [g for g in goals if g["configuration"] == "ONE_START"]
     assert one_start and all(g["status"] == "reached" for g in one_start)
-    assert sum(v["kind"] == "random" for v in files["readhesion.jsonl"][1:]) == 5
-    assert sum(v["kind"] == "random" for v in files["readhesion.one_start.jsonl"][1:]) == 1
-    assert cov["files"] == {n: len(lines) - 1 for n, lines in files.items()}
-    on_disk = json.loads((out / "readhesion.coverage.json").read_text(encoding="utf-8"))
-    assert on_disk["reached"] == cov["reached"]
+    # the default configuration's goals searched in ONE_START too: their vectors in the one-start file
+    ids = {v["id"] for v in vs.vectors("ra.one_start.jsonl")}
+    variant = [x for g in goals for x in g.get("variant_vectors", [])]
+    assert variant and set(variant) <= ids
 
 
-@needs_spin
-def test_vectors_follow_the_design_note(generated):
+def test_vectors_follow_the_design_note():
     """Invariants of design note §5 on every step of every vector (the exact values are the
     C++ conformance runner's check)."""
-    _cov, files, _out, b = generated
-    for name, lines in files.items():
+    vs = vector_set("ra")
+    for name, lines in vs.files.items():
+        spacing = lines[0]["parameters"]["spacing_cycles"]
         points = lines[0]["parameters"]["start_points"]
         for v in lines[1:]:
             prev = "TG"
@@ -257,7 +215,7 @@ def test_vectors_follow_the_design_note(generated):
                 if o["detected"]:  # REQ-RA-004/010: ages from the start point, too old discarded
                     t_max = o["max_compensation_cycles"]
                     for k in range(points):
-                        age = i["start_age_cycles"] + k * b["spacing"]
+                        age = i["start_age_cycles"] + k * spacing
                         c = o["candidates"][k]
                         if age <= t_max:
                             assert c["active"] or o["mode"] != "COMPENSATING"
@@ -267,10 +225,10 @@ def test_vectors_follow_the_design_note(generated):
                 prev = o["mode"]
 
 
-@needs_spin
-def test_boundary_vectors_hit_the_boundaries(generated):
-    _cov, files, _out, b = generated
-    vecs = {v["goal"]: v for v in files["readhesion.jsonl"][1:] if v["goal"]}
+def test_boundary_vectors_hit_the_boundaries():
+    vs = vector_set("ra")
+    vecs = vs.by_goal("ra.jsonl")
+    confirm = vs.header("ra.jsonl")["parameters"]["confirm_cycles"]
     last = {g: v["steps"][-1] for g, v in vecs.items()}
     # G12: compensating at exactly t_max; G13: the last candidate discarded at t_max + 1
     o = last["G12"]["out"]
@@ -280,7 +238,7 @@ def test_boundary_vectors_hit_the_boundaries(generated):
     assert before["candidates"][0]["age_cycles"] == o["max_compensation_cycles"]  # one more cycle: t_max + 1
     # G4: adoption exactly MODEL_CONFIRM cycles after the detection; G10: both confirm, primary wins
     det = next(k for k, s in enumerate(vecs["G4"]["steps"]) if s["out"]["detected"])
-    assert len(vecs["G4"]["steps"]) - 1 - det == b["confirm"] and last["G4"]["out"]["adopted"] == 0
+    assert len(vecs["G4"]["steps"]) - 1 - det == confirm and last["G4"]["out"]["adopted"] == 0
     assert last["G10"]["in"]["speed_agrees"] == [True, True] and last["G10"]["out"]["adopted"] == 0
     assert last["G8"]["out"]["adopted"] == 1
     # G6: the speed condition alone restarts the confirmation

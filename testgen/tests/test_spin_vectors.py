@@ -1,28 +1,37 @@
-"""Tests of the SPIN runner and the vector derivation (railproof_testgen.spin / .vectors)."""
+"""Tests of the SPIN runner and the generic vector engine (railproof_testgen.spin, .vectors) on
+the tiny fixture models of fixtures/spin: tiny.pml (one counter, verification) and counters.pml
+(two interleaved counters, a few hundred states: goals at several depths, one reachable only in
+the variant WIDE, one never, one in configuration FAST). The fixture's part of vector
+generation is the class Counters below, its schema and justification fixtures/spin/spec. The
+vector sets of a build, read from RAILPROOF_RESULTS_DIR, are checked at the end."""
+import json
 import shutil
+import subprocess
 from pathlib import Path
 
 import pytest
 
-from railproof_testgen import spin, vectors
+from railproof_testgen import registry, spin, vectors
 from railproof_testgen.errors import PipelineError, SpecError
+from railproof_testgen.vectors import Configuration
+from vector_results import check_vector_set, vector_set
 
 FIX = Path(__file__).parent / "fixtures" / "spin"
 REPO = Path(__file__).resolve().parents[2]
+COUNTERS = FIX / "counters.pml"
 needs_spin = pytest.mark.skipif(shutil.which("spin") is None or shutil.which("cc") is None,
                                 reason="spin and a C compiler are needed")
 
 
-def test_annotations_of_the_telegram_model():
-    ann = spin.parse_annotations(REPO / "models" / "telegram.pml")
-    names = {p.name for p in ann.properties}
-    assert "REQ_TG_009_turnaround" in names
-    assert all(p.requirements for p in ann.properties)
-    assert len(ann.goals) == 20 and [g.number for g in ann.goals] == list(range(20))
-    assert {m.name for m in ann.mutants} >= {"MUTANT_SEQ_WIDTH_8", "MUTANT_NO_AUTH_CHECK"}
-    assert "R_GUARANTEE_ECHO_AGE" in ann.asserts
-    healthy = [p for p in ann.properties if p.config == "HEALTHY"]
-    assert [p.name for p in healthy] == ["REQ_TG_016_availability"]
+# ---- annotations and pan output ----------------------------------------------------------------
+def test_annotations_of_the_fixture():
+    ann = spin.parse_annotations(COUNTERS)
+    assert [g.number for g in ann.goals] == list(range(6))
+    assert [g.config for g in ann.goals] == [None] * 5 + ["FAST"]
+    assert ann.goals[1].requirements == ["REQ-TG-001", "REQ-TG-003"]
+    assert ann.goals[2].label == "boundary: a at the limit"
+    assert [(p.name, p.configs) for p in ann.properties] == [("P_LIMIT", [None]), ("P_STEPS", ["FAST"])]
+    assert [(v.define, v.parameter, v.bound) for v in ann.variants] == [("WIDE", "limit", "wide_limit")]
 
 
 def test_mutant_naming_an_unknown_property_is_rejected(tmp_path):
@@ -48,55 +57,6 @@ def test_parse_pan_flags_truncated_searches_as_incomplete():
     assert res["incomplete"] == ["search depth bound reached"]
 
 
-def test_parse_events_and_steps_for_both_roles():
-    text = "\n".join([
-        "  @IN tick", "  @OUT tx seq=7 echo=255 link=0 eb=1 abnormal=1",
-        "  @IN rx seq=6 echo=7 mode=4", "  @OUT rx verdict=2 gap=0 link=0 eb=1 abnormal=1",
-        "  @IN rx seq=6 echo=7 mode=0", "  @OUT rx verdict=0 gap=0 link=1 eb=0 abnormal=0",
-        "  @IN tick"])  # an input cut off by the end of a trail is dropped
-    ev = vectors.parse_events(text)
-    assert len(ev) == 3
-    ids = {"ground_id": 1, "train_id": 42, "other_train_id": 43}
-    g = vectors.to_steps(ev, "ground", ids)
-    t = vectors.to_steps(ev, "train", ids)
-    assert g[0]["out"] == {"tx": {"seq": 7, "echo": None}, "link": "NONE", "tracking": "ABNORMAL"}
-    assert t[0]["out"] == {"tx": {"seq": 7, "echo": None}, "link": "NONE", "eb": True}
-    # misaddressed: from another train towards the ground, towards another train from the ground
-    assert g[1]["in"]["tg"]["src"] == 43 and g[1]["in"]["tg"]["type"] == "POSITION"
-    assert t[1]["in"]["tg"]["dst"] == 43 and t[1]["in"]["tg"]["type"] == "CONTROL"
-    assert g[1]["out"]["verdict"] == "REJ_ADDRESS"
-    assert t[2]["out"] == {"verdict": "ACCEPT", "gap": 0, "link": "UP", "eb": False}
-    assert vectors.observed_requirements(ev) == {"REQ-TG-003", "REQ-TG-008"}
-
-
-def test_output_without_input_is_an_error():
-    with pytest.raises(PipelineError, match="without @IN"):
-        vectors.parse_events("@OUT rx verdict=0 gap=0 link=1 eb=0 abnormal=0")
-
-
-@needs_spin
-def test_verify_fails_with_the_counterexample_on_a_violated_property(tmp_path):
-    with pytest.raises(PipelineError) as exc:
-        spin.verify(FIX / "tiny.pml", FIX, tmp_path / "work", tmp_path / "out.json", jobs=1)
-    msg = str(exc.value)
-    assert "P_BELOW (REQ-TG-008) [default] violated" in msg
-    assert "@OUT tx seq=" in msg  # the replayed counterexample is shown
-    import json
-    res = json.loads((tmp_path / "out.json").read_text())
-    assert res["properties"][0]["verdict"] == "violated"
-
-
-@needs_spin
-def test_verify_passes_when_the_property_holds(tmp_path):
-    params = tmp_path / "params"
-    params.mkdir()
-    (params / "tiny_params.pml").write_text("#define MODEL_WRAP 4\n#define MODEL_LIMIT 5\n")
-    res = spin.verify(FIX / "tiny.pml", params, tmp_path / "work", tmp_path / "out.json", jobs=1)
-    p = res["properties"][0]
-    assert p["verdict"] == "verified" and p["errors"] == 0 and p["states_stored"] > 0
-    assert res["bounds"] == {"wrap": 4, "limit": 5}
-
-
 def test_run_retries_text_file_busy_and_raises_other_errors(monkeypatch):
     """A freshly linked ./pan can be 'text file busy' for a moment under load: retried; any
     other OSError is not."""
@@ -119,6 +79,29 @@ def test_run_retries_text_file_busy_and_raises_other_errors(monkeypatch):
     monkeypatch.setattr(spin.subprocess, "run", missing)
     with pytest.raises(OSError):
         spin._run(["true"], ".")
+
+
+# ---- verification ------------------------------------------------------------------------------
+@needs_spin
+def test_verify_fails_with_the_counterexample_on_a_violated_property(tmp_path):
+    with pytest.raises(PipelineError) as exc:
+        spin.verify(FIX / "tiny.pml", FIX, tmp_path / "work", tmp_path / "out.json", jobs=1)
+    msg = str(exc.value)
+    assert "P_BELOW (REQ-TG-008) [default] violated" in msg
+    assert "@OUT tx seq=" in msg  # the replayed counterexample is shown
+    res = json.loads((tmp_path / "out.json").read_text())
+    assert res["properties"][0]["verdict"] == "violated"
+
+
+@needs_spin
+def test_verify_passes_when_the_property_holds(tmp_path):
+    params = tmp_path / "params"
+    params.mkdir()
+    (params / "tiny_params.pml").write_text("#define MODEL_WRAP 4\n#define MODEL_LIMIT 5\n")
+    res = spin.verify(FIX / "tiny.pml", params, tmp_path / "work", tmp_path / "out.json", jobs=1)
+    p = res["properties"][0]
+    assert p["verdict"] == "verified" and p["errors"] == 0 and p["states_stored"] > 0
+    assert res["bounds"] == {"wrap": 4, "limit": 5}
 
 
 TWO_INVARIANTS = """/* two invariants of one counter (tests of the combined search) */
@@ -158,7 +141,6 @@ def test_invariant_claims_and_their_conjunction():
 
 @needs_spin
 def test_properties_of_a_configuration_are_verified_in_one_search(tmp_path):
-    import subprocess
     model, params = _two(tmp_path, wrap=4)
     res = spin.verify(model, params, tmp_path / "work", tmp_path / "out.json", jobs=1)
     below, small = res["properties"]
@@ -182,8 +164,390 @@ def test_a_violation_found_together_is_reported_against_its_property(tmp_path):
         spin.verify(model, params, tmp_path / "work", tmp_path / "out.json", jobs=2)
     assert "P_BELOW (REQ-TG-008) [default] violated" in str(exc.value)
     assert "P_SMALL" not in str(exc.value)
-    import json
     below, small = json.loads((tmp_path / "out.json").read_text())["properties"]
     assert below["verdict"] == "violated" and "@OUT tx seq=5" in below["counterexample"]
     assert small["verdict"] == "verified" and small["command"].endswith("./pan -N P_SMALL")
     assert "verified_with" not in small
+
+
+@needs_spin
+def test_verify_checks_every_configuration_and_variant(tmp_path):
+    res = spin.verify(COUNTERS, _params(tmp_path), tmp_path / "work", tmp_path / "out.json", jobs=2)
+    runs = {(p["name"], p["configuration"]): p for p in res["properties"]}
+    # P_LIMIT in the default configuration and in the variant WIDE, P_STEPS in FAST
+    assert set(runs) == {("P_LIMIT", "default"), ("P_LIMIT", "WIDE"), ("P_STEPS", "FAST")}
+    assert all(p["verdict"] == "verified" and p["states_stored"] > 0 for p in runs.values())
+    assert runs[("P_LIMIT", "WIDE")]["states_stored"] > runs[("P_LIMIT", "default")]["states_stored"]
+
+
+# ---- the trap search ---------------------------------------------------------------------------
+def _params(tmp_path):
+    params = tmp_path / "params"
+    params.mkdir(exist_ok=True)
+    shutil.copy2(FIX / "counters_params.pml", params)
+    return params
+
+
+def _io(text):
+    return [ln.strip() for ln in text.splitlines() if "@IN" in ln or "@OUT" in ln]
+
+
+@needs_spin
+@pytest.mark.parametrize("config", [None, "WIDE", "FAST"])
+def test_one_search_gives_each_goal_the_run_of_its_own_trap_property(tmp_path, config):
+    """The technique's reference: every goal K searched alone with `ltl goalK { [] !g[K] }`
+    (pan -DBFS stops at its first violation). The one search of all goals must give each goal
+    the same run, and an unreachable goal the same complete search."""
+    params = _params(tmp_path)
+    ann = spin.parse_annotations(COUNTERS)
+    numbers = [g.number for g in ann.goals]
+    defines = ["TRAPS"] + ([config] if config else [])
+    s = spin.search_goals(COUNTERS, params, tmp_path / "search", defines, numbers)
+    ref = spin.prepare(COUNTERS, params, tmp_path / "ref", defines,
+                       texts={spin.goals_file(COUNTERS): "".join(f"ltl goal{k} {{ [] !g[{k}] }}\n" for k in numbers)})
+    unreachable = 0
+    for k in numbers:
+        r = spin._run(["./pan", "-N", f"goal{k}"], ref)
+        res = spin.parse_pan(r.stdout)
+        if not res["errors"]:
+            unreachable += 1
+            assert k not in s.trails
+            assert not res["incomplete"] and res["states_stored"] == s.res["states_stored"]
+            continue
+        own = spin._run(["spin", *[f"-D{d}" for d in defines], "-t", COUNTERS.name], ref).stdout
+        (ref / f"{COUNTERS.name}.trail").unlink()
+        assert _io(s.replay(s.trails[k], tmp_path / f"replay{k}")) == _io(own), f"goal {k}"
+    assert unreachable == {None: 2, "WIDE": 1, "FAST": 2}[config]
+
+
+@needs_spin
+def test_a_model_assertion_in_the_trap_search_is_an_error(tmp_path):
+    with pytest.raises(PipelineError, match=r"violated outside its goals: assertion violated"):
+        spin.search_goals(COUNTERS, _params(tmp_path), tmp_path / "search", ["TRAPS", "BROKEN"], [0, 1, 2])
+
+
+def test_a_model_without_the_goals_include_is_named(tmp_path):
+    model = tmp_path / "counters.pml"
+    model.write_text(COUNTERS.read_text().replace('#include "counters_goals.pml"', ""))
+    with pytest.raises(SpecError, match=r'counters.pml: TRAPS: the model does not #include "counters_goals.pml"'):
+        spin.search_goals(model, _params(tmp_path), tmp_path / "search", ["TRAPS"], [0])
+
+
+def test_an_incomplete_search_does_not_make_goals_unreachable(tmp_path, monkeypatch):
+    monkeypatch.setattr(spin, "prepare", lambda *a, **k: tmp_path)
+    out = ("error: max search depth too small\nFull statespace search for:\n"
+           "State-vector 36 byte, depth reached 9999, errors: 0\n  905 states, stored\n")
+    monkeypatch.setattr(spin, "_run", lambda *a, **k: subprocess.CompletedProcess(a, 0, out, ""))
+    with pytest.raises(PipelineError, match=r"\[TRAPS\]: trap search incomplete \(search depth bound "
+                                            r"reached\); goals not reached: G0, G1"):
+        spin.search_goals(COUNTERS, tmp_path, tmp_path, ["TRAPS"], [0, 1], pan_flags=[])
+    monkeypatch.setattr(spin, "_run", lambda *a, **k: subprocess.CompletedProcess(a, 0, "Segmentation fault", ""))
+    with pytest.raises(PipelineError, match="unexpected output of pan"):
+        spin.search_goals(COUNTERS, tmp_path, tmp_path, ["TRAPS"], [0, 1], pan_flags=[])
+
+
+# ---- the engine, with the fixture's part ---------------------------------------------------------
+class Counters(vectors.Part):
+    prefix = "CT"
+    configurations = (Configuration(None, walks=1),
+                      Configuration("WIDE", suffix=".wide", tag="WIDE-"),
+                      Configuration("FAST", suffix=".fast", tag="FAST-", walks=4, walk_evidence=True))
+    variant_search = "unreachable"
+    walk_defines = ()
+    walk_events = "steps"
+
+    def bounds(self, model, params_pml):
+        return vectors.model_bounds(params_pml, ("limit", "wide_limit", "steps"))
+
+    def parse_events(self, text):
+        events, pending = [], None
+        for line in _io(text):
+            if line.startswith("@IN "):
+                pending = line[4:]
+            elif pending is None:
+                raise PipelineError(f"@OUT without @IN: {line}")
+            else:
+                a, b = (int(x.split("=")[1]) for x in line[5:].split())
+                events.append((pending, a, b))
+                pending = None
+        return events
+
+    def to_steps(self, events, bounds, define):
+        return [{"in": {"proc": p}, "out": {"a": a, "b": b}} for p, a, b in events]
+
+    def observed_requirements(self, steps):
+        """Every run shows the counting (REQ-TG-001), b catching up with a REQ-TG-003."""
+        caught_up = any(s["out"]["a"] == s["out"]["b"] > 0 for s in steps)
+        return {"REQ-TG-001"} | ({"REQ-TG-003"} if caught_up else set())
+
+    def header(self, target, define):
+        b = target.bounds
+        return target.header(configuration=self.configuration(define).name,
+                             parameters={"limit": b["wide_limit" if define == "WIDE" else "limit"],
+                                         "steps": b["steps"]})
+
+
+def _generate(tmp_path, part=None, spec=FIX / "spec", walks=3, out=None):
+    out = out or tmp_path / "out"
+    return vectors.generate(COUNTERS, _params(tmp_path), spec, tmp_path / "work", out, walks=walks, jobs=2,
+                            part=("ct", part or Counters())), out
+
+
+def _lines(path):
+    return [json.loads(ln) for ln in path.read_text(encoding="utf-8").splitlines()]
+
+
+@pytest.fixture(scope="module")
+def generated(tmp_path_factory):
+    if shutil.which("spin") is None or shutil.which("cc") is None:
+        pytest.skip("spin and a C compiler are needed")
+    tmp = tmp_path_factory.mktemp("ct")
+    (tmp / "out").mkdir()
+    (tmp / "out" / "counters.old.jsonl").write_text("{}\n")  # a file of an earlier configuration
+    (tmp / "out" / "other.jsonl").write_text("{}\n")         # another model's
+    cov, out = _generate(tmp)
+    return cov, out, {p.name: _lines(p) for p in out.glob("counters*.jsonl")}
+
+
+@needs_spin
+def test_files_of_every_configuration_with_vectors(generated):
+    cov, out, files = generated
+    assert sorted(files) == ["counters.fast.jsonl", "counters.jsonl", "counters.wide.jsonl"]
+    assert (out / "other.jsonl").exists()  # only the model's own earlier files are removed
+    assert cov["files"] == {n: len(lines) - 1 for n, lines in files.items()}
+    assert json.loads((out / "counters.coverage.json").read_text()) == cov
+    for name, lines in files.items():
+        h = lines[0]
+        assert h["kind"] == "header" and h["model"] == "models/counters.pml"
+        assert h["model_sha256"] == spin.sha256_file(COUNTERS) and h["generator"].startswith("railproof_testgen")
+    assert files["counters.wide.jsonl"][0]["configuration"] == "WIDE"
+    assert files["counters.wide.jsonl"][0]["parameters"] == {"limit": 4, "steps": 8}
+    assert not list(out.glob("*.tmp"))
+
+
+@needs_spin
+def test_goal_coverage_with_variant_and_justification(generated):
+    cov, _out, files = generated
+    goals = {g["id"]: g for g in cov["goals"]}
+    assert [g["id"] for g in cov["goals"]] == [f"G{k}" for k in range(6)]
+    assert cov["labelled"] == 6 and cov["reached"] == 4 and cov["unreachable_justified"] == 2
+    assert goals["G2"]["vectors"] == ["CT-BOUNDARY-G2"] and goals["G0"]["vectors"] == ["CT-TRAP-G0"]
+    assert goals["G5"]["configuration"] == "FAST" and goals["G5"]["vectors"] == ["CT-TRAP-FAST-G5"]
+    # unreachable in the default configuration, reached in the variant: its own file
+    g3 = goals["G3"]
+    assert g3["status"] == "unreachable" and g3["justification"] == "UR-TG-901" and g3["states_searched"] > 0
+    assert g3["variant"] == "WIDE" and g3["variant_vectors"] == ["CT-TRAP-WIDE-G3"]
+    assert [v["id"] for v in files["counters.wide.jsonl"][1:]] == ["CT-TRAP-WIDE-G3"]
+    # unreachable everywhere, justified; only the goals unreachable at home are searched again
+    g4 = goals["G4"]
+    assert g4["justification"] == "UR-TG-902" and g4["states_searched"] == g3["states_searched"]
+    assert "variant" not in g4 and "variant" not in goals["G0"]
+    assert all(g["justification"] is None and g["states_searched"] is None
+               for g in cov["goals"] if g["status"] == "reached")
+
+
+@needs_spin
+def test_trap_vectors_are_the_replayed_runs(generated):
+    _cov, _out, files = generated
+    vecs = {v["id"]: v for lines in files.values() for v in lines[1:]}
+    g0, g1 = vecs["CT-TRAP-G0"], vecs["CT-TRAP-G1"]
+    assert g0["goal"] == "G0" and g0["kind"] == "trap" and g0["seed"] is None
+    assert [s["in"]["proc"] for s in g0["steps"]] == ["up", "up"] and g0["steps"][-1]["out"]["a"] == 2
+    assert g1["requirements"] == ["REQ-TG-001", "REQ-TG-003"]
+    assert vecs["CT-TRAP-G0"]["requirements"] == ["REQ-TG-001"]  # the goal's own and what the run shows
+    assert vecs["CT-BOUNDARY-G2"]["requirements"] == ["REQ-TG-001", "REQ-TG-004"]
+    last = g1["steps"][-1]
+    assert last["in"]["proc"] == "down" and last["out"]["a"] == last["out"]["b"] > 0
+    assert vecs["CT-TRAP-WIDE-G3"]["steps"][-1]["out"]["a"] == 4
+    assert vecs["CT-BOUNDARY-G2"]["kind"] == "boundary"
+
+
+@needs_spin
+def test_random_walks_per_configuration(generated):
+    _cov, _out, files = generated
+    main = files["counters.jsonl"][1:]
+    # boundary, trap, then random vectors, each by number
+    assert [v["id"] for v in main] == ["CT-BOUNDARY-G2", "CT-TRAP-G0", "CT-TRAP-G1",
+                                       "CT-RANDOM-S1", "CT-RANDOM-S2", "CT-RANDOM-S3"]
+    walks = [v for v in main if v["kind"] == "random"]
+    assert [v["seed"] for v in walks] == [1, 2, 3] and all(v["goal"] is None for v in walks)
+    assert all(len(v["steps"]) == 8 for v in walks)  # Part.walk_events: MODEL_STEPS
+    assert len({json.dumps(v["steps"]) for v in walks}) > 1  # the seeds give different runs
+    fast = [v for v in files["counters.fast.jsonl"][1:] if v["kind"] == "random"]
+    assert [v["id"] for v in fast] == ["CT-RANDOM-FAST-S1"]  # walks // 4, at least one
+    assert "REQ-TG-005" in fast[0]["requirements"]  # the property verified in FAST (walk_evidence)
+    assert all("REQ-TG-005" not in v["requirements"] for v in walks)
+
+
+@needs_spin
+def test_a_random_walk_is_reproduced_by_its_seed(tmp_path):
+    gen = vectors.Generation("ct", Counters(), COUNTERS, _params(tmp_path), FIX / "spec", tmp_path / "w",
+                             tmp_path / "o", walks=3, walk_steps=None, jobs=1)
+    assert gen.walk((None, 2)) == gen.walk((None, 2))
+    assert gen.walk((None, 2))[1] != gen.walk((None, 3))[1]
+    assert len(gen.walk(("FAST", 1))[1]) == 8
+
+
+RUN = [("up", 1, 0), ("up", 2, 0)]
+
+
+def _canned(monkeypatch):
+    """The engine without the trap searches: G3 and G4 unreachable, the other goals reached by
+    the run RUN (their vectors and coverage come from the engine as after a search)."""
+    def search_plan(self):
+        out = {(g.number, g.config): vectors.Outcome("reached", RUN, None) for g in self.ann.goals}
+        out.update({(k, None): vectors.Outcome("unreachable", None, 1010) for k in (3, 4)})
+        return out
+
+    monkeypatch.setattr(vectors.Generation, "search_plan", search_plan)
+
+
+@pytest.mark.parametrize("policy", ["all", "unreachable"])
+def test_default_goals_searched_again_in_the_variant(tmp_path, monkeypatch, policy):
+    """Part.variant_search: every default-configuration goal, or those unreachable there, is
+    searched again in each @variant."""
+    plans = []
+
+    def search(self, plan):
+        plans.append({d: [g.gid for g in gs] for d, gs in plan.items()})
+        unreachable = {3, 4}
+        return {(g.number, d): vectors.Outcome("unreachable" if g.number in unreachable else "reached",
+                                               None if g.number in unreachable else RUN, 7)
+                for d, gs in plan.items() for g in gs}
+
+    monkeypatch.setattr(vectors.Generation, "search", search)
+    part = Counters()
+    part.variant_search = policy
+    gen = vectors.Generation("ct", part, COUNTERS, _params(tmp_path), FIX / "spec", tmp_path / "w", tmp_path / "o",
+                             walks=1, walk_steps=None, jobs=1)
+    gen.search_plan()
+    home = {None: ["G0", "G1", "G2", "G3", "G4"], "FAST": ["G5"]}
+    if policy == "all":
+        assert plans == [{**home, "WIDE": ["G0", "G1", "G2", "G3", "G4"]}]
+    else:
+        assert plans == [home, {"WIDE": ["G3", "G4"]}]
+
+
+def _spec_with(tmp_path, justifications):
+    spec = tmp_path / f"spec{len(list(tmp_path.glob('spec*')))}"
+    shutil.copytree(FIX / "spec", spec)
+    (spec / "justifications" / "ct.yaml").write_text(justifications)
+    return spec
+
+
+@needs_spin
+def test_unjustified_unreachable_goal_and_justified_reached_goal_fail(tmp_path, monkeypatch):
+    _canned(monkeypatch)
+    spec = _spec_with(tmp_path, "schema: railproof/justifications/1\njustifications:\n"
+                                "  - {id: UR-TG-901, goal: G3, model: models/counters.pml, text: t}\n"
+                                "  - {id: UR-TG-902, goal: G0, model: models/counters.pml, text: t}\n"
+                                "  - {id: UR-TG-903, goal: G9, model: models/counters.pml, text: t}\n"
+                                "  - {id: UR-TG-904, goal: G4, model: models/other.pml, text: t}\n")
+    with pytest.raises(PipelineError) as exc:
+        _generate(tmp_path, spec=spec, walks=1)
+    msg = str(exc.value)
+    assert "spec/justifications/ct.yaml: G4: goal unreachable in default (a above 7 (never)) and not justified" in msg
+    assert "spec/justifications/ct.yaml: UR-TG-902: justifies goal G0, which is reached" in msg
+    assert "UR-TG-903: justifies goal G9, which is not a goal of the model" in msg
+    assert "UR-TG-901" not in msg and "UR-TG-904" not in msg  # G3 is justified; another model's
+    # the files are written: the coverage shows the problem
+    cov = json.loads((tmp_path / "out" / "counters.coverage.json").read_text())
+    goals = {g["id"]: g for g in cov["goals"]}
+    assert goals["G4"]["justification"] is None and goals["G4"]["states_searched"] == 1010
+    assert goals["G3"]["justification"] == "UR-TG-901" and cov["unreachable_justified"] == 1
+
+
+def test_malformed_justification_names_the_entry(tmp_path):
+    spec = _spec_with(tmp_path, "schema: railproof/justifications/1\njustifications:\n  - {id: UR-TG-902}\n")
+    with pytest.raises(SpecError, match=r"ct.yaml: justifications\[0\]: an entry needs 'id', 'goal' and 'model'"):
+        vectors.load_justifications(spec, "ct", "models/counters.pml")
+    spec = _spec_with(tmp_path, "schema: railproof/justifications/1\njustifications:\n"
+                                "  - {id: UR-TG-902, goal: G4, model: models/counters.pml, text: t}\n"
+                                "  - {id: UR-TG-903, goal: G4, model: models/counters.pml, text: t}\n")
+    with pytest.raises(SpecError, match="UR-TG-903: goal G4 is already justified by UR-TG-902"):
+        vectors.load_justifications(spec, "ct", "models/counters.pml")
+
+
+@needs_spin
+def test_a_schema_violation_names_the_field_and_writes_nothing(tmp_path, monkeypatch):
+    _canned(monkeypatch)
+
+    class Broken(Counters):
+        def to_steps(self, events, bounds, define):
+            steps = super().to_steps(events, bounds, define)
+            steps[0]["out"]["a"] = "two"
+            return steps
+
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "counters.jsonl").write_text("earlier\n")
+    with pytest.raises(PipelineError, match=r"generated counters.jsonl line 2 violates the vector schema: "
+                                            r"steps/0/out/a: 'two' is not of type 'integer'$"):
+        _generate(tmp_path, Broken(), walks=1, out=out)
+    assert sorted(p.name for p in out.iterdir()) == ["counters.jsonl"]
+    assert (out / "counters.jsonl").read_text() == "earlier\n"
+
+
+def test_atomic_write_leaves_the_old_file_or_the_new_one(tmp_path, monkeypatch):
+    target = tmp_path / "v.jsonl"
+    target.write_text("old\n")
+    vectors.atomic_write(target, "new\n")
+    assert target.read_text() == "new\n" and not list(tmp_path.glob("*.tmp"))
+
+    def fail(self, other):
+        raise OSError("disk full")
+
+    monkeypatch.setattr(Path, "replace", fail)
+    with pytest.raises(OSError, match="disk full"):
+        vectors.atomic_write(target, "newer\n")
+    assert target.read_text() == "new\n" and not list(tmp_path.glob("*.tmp"))
+
+
+def test_a_goal_in_a_configuration_the_part_does_not_generate(tmp_path):
+    model = tmp_path / "counters.pml"
+    model.write_text(COUNTERS.read_text().replace("[config FAST]", "[config SLOW]"))
+    with pytest.raises(SpecError, match=r"counters.pml: G5: goal in configuration SLOW, in which capability ct "
+                                        r"generates no vectors"):
+        vectors.generate(model, _params(tmp_path), FIX / "spec", tmp_path / "w", tmp_path / "o",
+                         part=("ct", Counters()))
+
+
+def test_walk_steps_only_for_walks_bounded_by_spin(tmp_path):
+    with pytest.raises(SpecError, match="--walk-steps: the model ends its random walks itself"):
+        vectors.generate(COUNTERS, _params(tmp_path), FIX / "spec", tmp_path / "w", tmp_path / "o",
+                         walk_steps=100, part=("ct", Counters()))
+
+
+def test_a_missing_model_bound_is_named(tmp_path):
+    params = tmp_path / "counters_params.pml"
+    params.write_text("#define MODEL_LIMIT 3\n")
+    with pytest.raises(SpecError, match=r"counters_params.pml: MODEL_STEPS: model bound missing "
+                                        r"\(spec/parameters/counters.yaml model_bounds\)"):
+        vectors.model_bounds(params, ("limit", "steps"))
+
+
+# ---- the registry's capabilities ---------------------------------------------------------------
+def test_every_registered_model_has_its_part():
+    """The registry finds each model's part; its configuration table covers every goal's
+    configuration and variant of the model, and its file suffixes are distinct."""
+    reg = registry.load(REPO / "spec")
+    for model in reg.models:
+        name, part = vectors.capability_part(REPO / "spec", REPO / model.path)
+        assert name == reg.of_model(model.path).name
+        ann = spin.parse_annotations(REPO / model.path)
+        defines = [c.define for c in part.configurations]
+        assert defines[0] is None and len(set(defines)) == len(defines)
+        assert {g.config for g in ann.goals} | {v.define for v in ann.variants} <= set(defines), model.name
+        assert part.prefix == name.upper() and part.configuration(None).walks == 1
+        assert (REPO / "spec" / "schemas" / f"vectors_{name}.schema.json").is_file()
+
+
+def test_a_model_of_no_capability_is_an_error(tmp_path):
+    with pytest.raises(SpecError, match="no capability lists the model counters.pml"):
+        vectors.capability_part(REPO / "spec", COUNTERS)
+
+
+# ---- the vector sets of the build (RAILPROOF_RESULTS_DIR) ---------------------------------------
+@pytest.mark.parametrize("model", [m.name for m in registry.load(REPO / "spec").models])
+def test_the_build_vector_set_is_valid_and_covers_every_goal(model):
+    check_vector_set(vector_set(model))

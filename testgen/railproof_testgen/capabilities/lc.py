@@ -1,18 +1,14 @@
-"""Conformance vectors of models/lc.pml (spec/design/lc.md §3-§6: the
-on-board crossing function, the crossing controllers and the centre scheduler).
+"""The level-crossing part of vector generation: models/lc.pml (spec/design/lc.md §3-§6: the
+on-board crossing function, the crossing controllers and the centre scheduler); the engine is
+vectors.py. Each goal is searched in the configuration its annotation names; random walks in
+configuration WALK (at most MODEL_CYCLES ticks; GNSS runs end at the model's horizon). One
+file per configuration, each with a header that records it:
 
-Same technique as the braking and re-adhesion vectors (br_vectors.py, ra_vectors.py): one
-trap property per `// @goal` (BFS: the shortest run reaching it, replayed with `spin -t`),
-searched in the configuration its annotation names; goals whose label names a boundary are
-the boundary vectors; then seeded random walks (configuration WALK, at most MODEL_CYCLES
-ticks; GNSS runs end at the model's horizon). One file per configuration, each with a header
-that records it:
-
-  level_crossing.jsonl               ONBOARD, one train (the model's default configuration)
-  level_crossing.long_warning.jsonl  ONBOARD, design warning time one tick longer
-  level_crossing.two_trains.jsonl    ONBOARD, a second train requesting crossing A
-  level_crossing.gnss.jsonl          GNSS-time pre-armed crossings (losses, delays, barriers)
-  level_crossing.gnss_clock.jsonl    GNSS with GNSS outages and clock faults
+  lc.jsonl               ONBOARD, one train (the model's default configuration)
+  lc.long_warning.jsonl  ONBOARD, design warning time one tick longer
+  lc.two_trains.jsonl    ONBOARD, a second train requesting crossing A
+  lc.gnss.jsonl          GNSS-time pre-armed crossings (losses, delays, barriers)
+  lc.gnss_clock.jsonl    GNSS with GNSS outages and clock faults
 
 Units (header "unit_scales"): a model tick is TICK_MS ms, a model cell CELL_MM mm (positions
 are half-cells), a speed unit (cells per tick) SPEED_MM_S mm/s, the acceleration 1 cell/tick²
@@ -24,24 +20,15 @@ a start time (half-ticks + 2W) is converted exactly. The model's ETA class (eta2
 is checked against an exact re-computation of the C++ rounding (EarliestArrivalMs of the
 design, one profile piece) for every value that occurs: the tick length is valid only if
 floor(E * TICK_MS) keeps the class, which the generator asserts.
-
-Every line is checked against spec/schemas/vectors_lc.schema.json before the files
-are written. A goal that the exhaustive search cannot reach must be justified in
-spec/justifications.
 """
 from __future__ import annotations
 
 import math
 import re
-import shutil
-from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
-from .. import __version__
-from .. import spin as spin_mod
 from ..errors import PipelineError, SpecError
-from ..vectors import _progress, load_justifications, search_goal, write_configuration_files, write_goals_file
-from ..vectors import model_bounds as _bounds
+from ..vectors import Configuration, Part, model_bounds
 
 TICK_MS = 10_000
 CELL_MM = 100_000
@@ -63,16 +50,10 @@ STATUS_OF = {"OPEN": "OPEN", "OPENING": "OPEN", "WARNING": "WARNING", "CLOSING":
 FAILURE_FROM = {"CLOSING": "BARRIER_NOT_DOWN", "CLOSED": "BARRIER_DOWN_LOST", "OPENING": "BARRIER_NOT_UP"}
 CLOCK_INPUTS = ["GNSS", "NO_GNSS", "FAULT"]
 CLOCK_STATES = ["SYNCHRONISED", "HOLDOVER", "FAULTY"]
-BOUNDARY_WORDS = ("boundary",)
 
-# configurations: model define (None = default) -> (file suffix, id tag, variant, warning extra)
-CONFIGS = {
-    None: ("", "", "ONBOARD", 0),
-    "LONG_WARNING": (".long_warning", "LONGWARN-", "ONBOARD", 1),
-    "TWO_TRAINS": (".two_trains", "TWOTRAINS-", "ONBOARD", 0),
-    "GNSS": (".gnss", "GNSS-", "GNSS", 0),
-    "GNSS_CLOCK": (".gnss_clock", "GNSSCLOCK-", "GNSS", 0),
-}
+# the model's variant of each configuration and the ticks it adds to the design warning time
+VARIANT = {None: ("ONBOARD", 0), "LONG_WARNING": ("ONBOARD", 1), "TWO_TRAINS": ("ONBOARD", 0),
+           "GNSS": ("GNSS", 0), "GNSS_CLOCK": ("GNSS", 0)}
 # model bounds of spec/parameters/lc.yaml, and the model-local ones (defaults in the
 # model, overridden by the parameters file once they are there)
 BOUNDS = ("track", "vmax", "lc_a", "lc_b", "train_len", "station", "warn_ticks", "lower_ticks", "max_delay",
@@ -82,7 +63,7 @@ LOCAL = ("lead_ticks", "conf_age_ticks", "prot_offset", "dwell_ticks", "gnss_dwe
 
 _LOCAL_DEFAULT = re.compile(r"#ifndef MODEL_(\w+)\s*\n#define MODEL_\1 ([^/\n]+?)\s*(?:/\*|\n)")
 
-# ---- parsing the model's output ---------------------------------------------------------------
+# ---- the model's output -------------------------------------------------------------------------
 _RX = {
     "tick": re.compile(r"@IN tick (?:t=(\d+) )?x=(\d+) v=(\d+) ph=(\d+) dw=(\d+)"),
     "ul": re.compile(r"@IN ul c=([01]) age=([01]) m=([12])"),
@@ -103,58 +84,6 @@ _RX = {
 }
 
 
-def parse_events(text: str):
-    """Replay/simulation output -> list of ticks (dicts of the raw model integers). A tick
-    begins with its @IN tick line and is complete with @OUT move; a tick cut off by the end of
-    a trail or walk is dropped."""
-    ticks, cur = [], None
-    for line in text.splitlines():
-        if "@IN" not in line and "@OUT" not in line:
-            continue
-        kind = next((k for k, rx in _RX.items() if rx.search(line)), None)
-        if kind is None:
-            raise PipelineError(f"unrecognised model output line: {line.strip()}")
-        m = _RX[kind].search(line)
-        g = [int(x) if x is not None else None for x in m.groups()]
-        if kind == "tick":
-            cur = {"t": g[0], "x": g[1], "v": g[2], "ph": g[3], "dw": g[4], "ul": [], "other": None, "bar": {},
-                   "ctrl": {}, "rx": [], "board": None, "pos": None, "ua": [], "centre": None, "ds": [],
-                   "clk": {}, "gctrl": {}}
-            continue
-        if cur is None:
-            raise PipelineError(f"model output outside a tick: {line.strip()}")
-        if kind == "ul":
-            cur["ul"].append({"c": g[0], "age": g[1], "m": g[2]})
-        elif kind == "other":
-            cur["other"] = g[0]
-        elif kind == "bar":
-            cur["bar"][g[0]] = (g[1], g[2])
-        elif kind == "ctrl":
-            cur["ctrl"][g[0]] = {"cs": g[1], "wa": g[2], "new": g[3], "ack": g[4], "rq": g[5]}
-        elif kind == "rx":
-            cur["rx"].append({"c": g[0], "age": g[1]})
-        elif kind == "board":
-            cur["board"] = {"s": [g[0], g[1]], "e": [g[2], g[3]], "lim": g[4]}
-        elif kind == "pos":
-            cur["pos"] = g[0]
-        elif kind == "ua":
-            cur["ua"].append({"c": g[0], "age": g[1]})
-        elif kind == "centre":
-            cur["centre"] = {"clr": g[0], "c": [dict(zip(("st", "p", "a", "x", "sp", "sa", "cf"), g[1 + 7 * c:8 + 7 * c]))
-                                                for c in (0, 1)]}
-        elif kind == "ds":
-            cur["ds"].append({"c": g[0], "age": g[1]})
-        elif kind == "clk":
-            cur["clk"][g[0]] = g[1]
-        elif kind == "gctrl":
-            cur["gctrl"][g[0]] = dict(zip(("cs", "wa", "new", "pres", "pst", "act", "ck", "ack", "acc", "sack"), g[1:]))
-        elif kind == "move":
-            cur["move"] = (g[0], g[1])
-            ticks.append(cur)
-            cur = None
-    return ticks
-
-
 # ---- bounds and the header ---------------------------------------------------------------------
 def model_local_defaults(model: Path) -> dict:
     """The model-local bounds (#ifndef MODEL_X / #define MODEL_X n) of the model file."""
@@ -170,11 +99,7 @@ def model_local_defaults(model: Path) -> dict:
 
 
 def all_bounds(model: Path, params_pml: Path) -> dict:
-    b = _bounds(params_pml)
-    for key in BOUNDS:
-        if key not in b:
-            raise SpecError(params_pml, f"MODEL_{key.upper()}",
-                            "model bound missing (spec/parameters/lc.yaml model_bounds)")
+    b = model_bounds(params_pml, BOUNDS)
     local = model_local_defaults(model)
     local.setdefault("dwell_ticks", local.get("lead_ticks", 0) + 1)  # the model's default expression
     for key in LOCAL:
@@ -186,7 +111,7 @@ def all_bounds(model: Path, params_pml: Path) -> dict:
 
 def timing(b: dict, config) -> dict:
     """Ticks of the configuration (the model's W, LOWER, TO, ...)."""
-    w = b["warn_ticks"] + CONFIGS[config][3]
+    w = b["warn_ticks"] + VARIANT[config][1]
     return {"W": w, "LOWER": b["lower_ticks"], "TO": w - b["lower_ticks"], "LEAD": b["lead_ticks"],
             "CMA": b["conf_age_ticks"], "PO": b["prot_offset"], "DWELL": b["dwell_ticks"],
             "GDWELL": b["gnss_dwell_ticks"], "HOLD": b["holdover_ticks"], "OFS": 2 * w}
@@ -196,39 +121,6 @@ def crossings(b: dict, config):
     t = timing(b, config)
     return [{"id": cid, "near_mm": lc * CELL_MM, "far_mm": (lc + 1) * CELL_MM, "warning_time_ms": t["W"] * TICK_MS}
             for cid, lc in zip(CROSSING_IDS, (b["lc_a"], b["lc_b"]))]
-
-
-def header_for(model: Path, b: dict, config):
-    _suffix, _tag, variant, _extra = CONFIGS[config]
-    t = timing(b, config)
-    params = {
-        "train": {"id": TRAIN_ID, "length_mm": b["train_len"] * CELL_MM, "accel_max_mm_s2": ACCEL_MM_S2},
-        "other_train_id": OTHER_TRAIN_ID,
-        "crossings": crossings(b, config),
-        "restrictions": [{"begin_mm": 0, "end_mm": (b["track"] + 2) * CELL_MM, "limit_mm_s": b["vmax"] * SPEED_MM_S}],
-        "protection": {"request_lead_ms": t["LEAD"] * TICK_MS, "confirmation_max_age_ms": t["CMA"] * TICK_MS,
-                       "protection_offset_mm": t["PO"] * CELL_MM, "lookahead_mm": 5_000_000},
-        "controller": {"barrier_lowering_ms": t["LOWER"] * TICK_MS, "barrier_timeout_ms": t["TO"] * TICK_MS,
-                       "max_warning_ms": MAX_WARNING_MS, "holdover_max_ms": t["HOLD"] * TICK_MS},
-        "station": {"front_mm": b["station"] * CELL_MM,
-                    "dwell_ms": (t["GDWELL"] if variant == "GNSS" else t["DWELL"]) * TICK_MS},
-        "model_bounds": {k: b[k] for k in BOUNDS + LOCAL},
-        "controller_states": CONTROLLER_STATES, "onboard_states": ONBOARD_STATES,
-    }
-    if variant == "GNSS":
-        params["scheduler"] = {"clock_allowance_ms": 0}
-        params["departure"] = {"train_id": TRAIN_ID, "departure_id": DEPARTURE_ID,
-                               "departure_ms": t["GDWELL"] * TICK_MS, "front_mm": b["station"] * CELL_MM,
-                               "started_at_ms": 0}
-    return {
-        "kind": "header", "schema_version": 1, "model": f"models/{model.name}",
-        "model_sha256": spin_mod.sha256_file(model), "generator": f"railproof_testgen {__version__}",
-        "spin_version": spin_mod.spin_version(), "configuration": config or "default", "variant": variant,
-        "units": UNITS,
-        "unit_scales": {"ms_per_tick": TICK_MS, "mm_per_cell": CELL_MM, "mm_per_half_cell": HALF_MM,
-                        "mm_s_per_speed_unit": SPEED_MM_S, "mm_s2_per_accel_unit": ACCEL_MM_S2},
-        "parameters": params,
-    }
 
 
 # ---- the exact ETA of the C++ (design §2, one profile piece) --------------------------------------
@@ -483,145 +375,149 @@ def gnss_steps(ticks, b: dict, config):
     return steps
 
 
-def to_steps(ticks, b: dict, config):
-    if CONFIGS[config][2] == "GNSS":
-        return gnss_steps(ticks, b, config)
-    return onboard_steps(ticks, b, config)
+# ---- the part -----------------------------------------------------------------------------------
+class LevelCrossing(Part):
+    prefix = "LC"
+    configurations = (
+        Configuration(None, walks=1),
+        Configuration("LONG_WARNING", suffix=".long_warning", tag="LONGWARN-", walks=5),
+        Configuration("TWO_TRAINS", suffix=".two_trains", tag="TWOTRAINS-", walks=5),
+        Configuration("GNSS", suffix=".gnss", tag="GNSS-", walks=5),
+        Configuration("GNSS_CLOCK", suffix=".gnss_clock", tag="GNSSCLOCK-", walks=5),
+    )
+
+    def bounds(self, model, params_pml):
+        return all_bounds(model, params_pml)
+
+    def parse_events(self, text):
+        """Replay/simulation output -> list of ticks (dicts of the raw model integers). A tick
+        begins with its @IN tick line and is complete with @OUT move; a tick cut off by the end of
+        a trail or walk is dropped."""
+        ticks, cur = [], None
+        for line in text.splitlines():
+            if "@IN" not in line and "@OUT" not in line:
+                continue
+            kind = next((k for k, rx in _RX.items() if rx.search(line)), None)
+            if kind is None:
+                raise PipelineError(f"unrecognised model output line: {line.strip()}")
+            m = _RX[kind].search(line)
+            g = [int(x) if x is not None else None for x in m.groups()]
+            if kind == "tick":
+                cur = {"t": g[0], "x": g[1], "v": g[2], "ph": g[3], "dw": g[4], "ul": [], "other": None, "bar": {},
+                       "ctrl": {}, "rx": [], "board": None, "pos": None, "ua": [], "centre": None, "ds": [],
+                       "clk": {}, "gctrl": {}}
+                continue
+            if cur is None:
+                raise PipelineError(f"model output outside a tick: {line.strip()}")
+            if kind == "ul":
+                cur["ul"].append({"c": g[0], "age": g[1], "m": g[2]})
+            elif kind == "other":
+                cur["other"] = g[0]
+            elif kind == "bar":
+                cur["bar"][g[0]] = (g[1], g[2])
+            elif kind == "ctrl":
+                cur["ctrl"][g[0]] = {"cs": g[1], "wa": g[2], "new": g[3], "ack": g[4], "rq": g[5]}
+            elif kind == "rx":
+                cur["rx"].append({"c": g[0], "age": g[1]})
+            elif kind == "board":
+                cur["board"] = {"s": [g[0], g[1]], "e": [g[2], g[3]], "lim": g[4]}
+            elif kind == "pos":
+                cur["pos"] = g[0]
+            elif kind == "ua":
+                cur["ua"].append({"c": g[0], "age": g[1]})
+            elif kind == "centre":
+                cur["centre"] = {"clr": g[0],
+                                 "c": [dict(zip(("st", "p", "a", "x", "sp", "sa", "cf"), g[1 + 7 * c:8 + 7 * c]))
+                                       for c in (0, 1)]}
+            elif kind == "ds":
+                cur["ds"].append({"c": g[0], "age": g[1]})
+            elif kind == "clk":
+                cur["clk"][g[0]] = g[1]
+            elif kind == "gctrl":
+                cur["gctrl"][g[0]] = dict(zip(("cs", "wa", "new", "pres", "pst", "act", "ck", "ack", "acc", "sack"),
+                                              g[1:]))
+            elif kind == "move":
+                cur["move"] = (g[0], g[1])
+                ticks.append(cur)
+                cur = None
+        return ticks
+
+    def to_steps(self, ticks, b, config):
+        if VARIANT[config][0] == "GNSS":
+            return gnss_steps(ticks, b, config)
+        return onboard_steps(ticks, b, config)
+
+    def observed_requirements(self, steps):
+        """Requirements evidenced by what a run shows (added to a goal's own)."""
+        reqs = set()
+        for s in steps:
+            for c in s["controllers"]:
+                st = c["out"]["state"]
+                if st != "OPEN":
+                    reqs.add("REQ-LC-006")
+                if st == "FAILED":
+                    reqs.add("REQ-LC-014")
+                if c["out"].get("start_acks"):
+                    reqs.update(["REQ-LC-009", "REQ-LC-010"])
+                if c["in"].get("warning_stops"):
+                    reqs.add("REQ-LC-012")
+                if c["in"].get("clock") in ("NO_GNSS", "FAULT"):
+                    reqs.add("REQ-LC-013")
+                if c["in"]["withdrawals"]:
+                    reqs.update(["REQ-LC-004", "REQ-LC-007"])
+            if "onboard" in s:
+                reqs.add("REQ-LC-001")
+                o = s["onboard"]["out"]
+                if o["requests"]:
+                    reqs.add("REQ-LC-002")
+                if "CLEARED" in o["states"] or o["stop_limit_mm"] is not None:
+                    reqs.add("REQ-LC-003")
+                if o["withdrawals"]:
+                    reqs.add("REQ-LC-004")
+                if s["train"]["dwell"]:
+                    reqs.add("REQ-LC-005")
+            if "centre" in s:
+                reqs.add("REQ-LC-008")
+                if s["centre"]["out"]["departure_cleared"]:
+                    reqs.add("REQ-LC-009")
+                if s["centre"]["in"]["position"] is not None:
+                    reqs.add("REQ-LC-010")
+                if any(c["out"]["pending"]["active"] for c in s["controllers"]):
+                    reqs.add("REQ-LC-011")
+        return reqs
+
+    def walk_length(self, b, config):
+        return b["cycles"] if VARIANT[config][0] == "ONBOARD" else min(b["cycles"], b["gnss_horizon"])
+
+    def header(self, target, config):
+        b = target.bounds
+        variant = VARIANT[config][0]
+        t = timing(b, config)
+        params = {
+            "train": {"id": TRAIN_ID, "length_mm": b["train_len"] * CELL_MM, "accel_max_mm_s2": ACCEL_MM_S2},
+            "other_train_id": OTHER_TRAIN_ID,
+            "crossings": crossings(b, config),
+            "restrictions": [{"begin_mm": 0, "end_mm": (b["track"] + 2) * CELL_MM,
+                              "limit_mm_s": b["vmax"] * SPEED_MM_S}],
+            "protection": {"request_lead_ms": t["LEAD"] * TICK_MS, "confirmation_max_age_ms": t["CMA"] * TICK_MS,
+                           "protection_offset_mm": t["PO"] * CELL_MM, "lookahead_mm": 5_000_000},
+            "controller": {"barrier_lowering_ms": t["LOWER"] * TICK_MS, "barrier_timeout_ms": t["TO"] * TICK_MS,
+                           "max_warning_ms": MAX_WARNING_MS, "holdover_max_ms": t["HOLD"] * TICK_MS},
+            "station": {"front_mm": b["station"] * CELL_MM,
+                        "dwell_ms": (t["GDWELL"] if variant == "GNSS" else t["DWELL"]) * TICK_MS},
+            "model_bounds": {k: b[k] for k in BOUNDS + LOCAL},
+            "controller_states": CONTROLLER_STATES, "onboard_states": ONBOARD_STATES,
+        }
+        if variant == "GNSS":
+            params["scheduler"] = {"clock_allowance_ms": 0}
+            params["departure"] = {"train_id": TRAIN_ID, "departure_id": DEPARTURE_ID,
+                                   "departure_ms": t["GDWELL"] * TICK_MS, "front_mm": b["station"] * CELL_MM,
+                                   "started_at_ms": 0}
+        return target.header(
+            configuration=self.configuration(config).name, variant=variant, units=UNITS,
+            unit_scales={"ms_per_tick": TICK_MS, "mm_per_cell": CELL_MM, "mm_per_half_cell": HALF_MM,
+                         "mm_s_per_speed_unit": SPEED_MM_S, "mm_s2_per_accel_unit": ACCEL_MM_S2},
+            parameters=params)
 
 
-# ---- requirements a run shows -------------------------------------------------------------------
-def observed_requirements(steps):
-    """Requirements evidenced by what a run shows (added to a goal's own)."""
-    reqs = set()
-    for s in steps:
-        for c in s["controllers"]:
-            st = c["out"]["state"]
-            if st != "OPEN":
-                reqs.add("REQ-LC-006")
-            if st == "FAILED":
-                reqs.add("REQ-LC-014")
-            if c["out"].get("start_acks"):
-                reqs.update(["REQ-LC-009", "REQ-LC-010"])
-            if c["in"].get("warning_stops"):
-                reqs.add("REQ-LC-012")
-            if c["in"].get("clock") in ("NO_GNSS", "FAULT"):
-                reqs.add("REQ-LC-013")
-            if c["in"]["withdrawals"]:
-                reqs.update(["REQ-LC-004", "REQ-LC-007"])
-        if "onboard" in s:
-            reqs.add("REQ-LC-001")
-            o = s["onboard"]["out"]
-            if o["requests"]:
-                reqs.add("REQ-LC-002")
-            if "CLEARED" in o["states"] or o["stop_limit_mm"] is not None:
-                reqs.add("REQ-LC-003")
-            if o["withdrawals"]:
-                reqs.add("REQ-LC-004")
-            if s["train"]["dwell"]:
-                reqs.add("REQ-LC-005")
-        if "centre" in s:
-            reqs.add("REQ-LC-008")
-            if s["centre"]["out"]["departure_cleared"]:
-                reqs.add("REQ-LC-009")
-            if s["centre"]["in"]["position"] is not None:
-                reqs.add("REQ-LC-010")
-            if any(c["out"]["pending"]["active"] for c in s["controllers"]):
-                reqs.add("REQ-LC-011")
-    return reqs
-
-
-def _vid(kind: str, config, tail: str) -> str:
-    return f"LC-{kind.upper()}-{CONFIGS[config][1]}{tail}"
-
-
-def generate(model: Path, params_dir: Path, spec_dir: Path, workdir: Path, out_dir: Path,
-             walks: int = 50, jobs: int = 2):
-    model = Path(model)
-    model_rel = f"models/{model.name}"
-    ann = spin_mod.parse_annotations(model)
-    if not ann.goals:
-        raise SpecError(model, "-", "no // @goal annotations: nothing to generate")
-    for g in ann.goals:
-        if g.config not in CONFIGS:
-            raise SpecError(model, g.gid, f"goal names unknown configuration {g.config}")
-    b = all_bounds(model, Path(params_dir) / f"{model.stem}_params.pml")
-    workdir = Path(workdir)
-    workdir.mkdir(parents=True, exist_ok=True)
-    goals_file = workdir / f"{model.stem}_goals.pml"
-    write_goals_file(ann, goals_file)
-    used = sorted({g.config for g in ann.goals} | set(CONFIGS), key=lambda c: c or "")
-    bases = {}
-    for cfg in used:
-        _progress(f"compiling trap model [{cfg or 'default'}] ({sum(g.config == cfg for g in ann.goals)} goals)")
-        bases[cfg] = spin_mod.prepare(model, params_dir, workdir / f"traps-{cfg or 'default'}",
-                                      ["TRAPS"] + ([cfg] if cfg else []), [goals_file])
-
-    def run_goal(g):
-        defs = ["TRAPS"] + ([g.config] if g.config else [])
-        return (g, *search_goal(model, bases[g.config], workdir, g, defs, parse_events))
-
-    with ThreadPoolExecutor(max_workers=max(1, jobs)) as ex:
-        outcomes = list(ex.map(run_goal, ann.goals))
-
-    justifications = load_justifications(spec_dir, model_rel)
-    per_config = {c: [] for c in CONFIGS}
-    coverage, problems = {}, []
-    for g, status, ticks, res in outcomes:
-        cfg = g.config
-        vid = None
-        if status == "reached":
-            kind = "boundary" if any(w in g.label.lower() for w in BOUNDARY_WORDS) else "trap"
-            steps = to_steps(ticks, b, cfg)
-            vid = _vid(kind, cfg, g.gid)
-            per_config[cfg].append({"id": vid, "requirements": sorted(set(g.requirements) | observed_requirements(steps)),
-                                    "goal": g.gid, "kind": kind, "seed": None, "steps": steps})
-            _progress(f"{g.gid} [{cfg or 'default'}] reached in {len(steps)} tick(s): {g.label}")
-        else:
-            _progress(f"{g.gid} [{cfg or 'default'}] UNREACHABLE ({res['states_stored']} states searched): {g.label}")
-        just = justifications.get(g.gid)
-        if status == "unreachable" and not just:
-            problems.append(f"goal {g.gid} ({g.label}) is unreachable and has no justification in "
-                            f"spec/justifications/ (model {model_rel})")
-        coverage[g.gid] = {"id": g.gid, "label": g.label, "requirements": g.requirements, "status": status,
-                           "configuration": cfg or "default", "vectors": [vid] if vid else [],
-                           "justification": just if status == "unreachable" else None,
-                           "states_searched": res["states_stored"] if status == "unreachable" else None}
-    unreachable = {gid for gid, c in coverage.items() if c["status"] == "unreachable"}
-    for gid in sorted(set(justifications) - unreachable):
-        problems.append(f"justification {justifications[gid]} names goal {gid}, which is reached or unknown")
-
-    def walk(job):
-        seed, cfg = job
-        # spin writes scratch files into its working directory: one directory per walk
-        wd = workdir / f"walk{seed}-{cfg or 'default'}"
-        if wd.exists():
-            shutil.rmtree(wd)
-        wd.mkdir()
-        for f in bases[None].glob("*.pml"):
-            shutil.copy2(f, wd / f.name)
-        dflags = ["-DWALK"] + ([f"-D{cfg}"] if cfg else [])
-        r = spin_mod._run(["spin", *dflags, f"-n{seed}", model.name], wd, timeout=300)
-        if r.returncode != 0:
-            raise PipelineError(f"spin simulation seed {seed} [WALK {cfg or ''}] failed: {r.stderr[-1000:]}")
-        ticks = parse_events(r.stdout)
-        limit = b["cycles"] if CONFIGS[cfg][2] == "ONBOARD" else min(b["cycles"], b["gnss_horizon"])
-        if len(ticks) != limit:
-            raise PipelineError(f"random walk seed {seed} [{cfg or 'default'}] produced {len(ticks)} ticks, "
-                                f"expected {limit}")
-        return seed, cfg, ticks
-
-    n_other = max(1, walks // 5)
-    jobs_list = [(seed, None) for seed in range(1, walks + 1)]
-    jobs_list += [(seed, c) for c in CONFIGS if c for seed in range(1, n_other + 1)]
-    _progress(f"{len(jobs_list)} random walks ({walks} in the default configuration, {n_other} in each other)")
-    with ThreadPoolExecutor(max_workers=max(1, jobs)) as ex:
-        walked = list(ex.map(walk, jobs_list))
-    for seed, cfg, ticks in walked:
-        steps = to_steps(ticks, b, cfg)
-        per_config[cfg].append({"id": _vid("random", cfg, f"S{seed}"),
-                                "requirements": sorted(observed_requirements(steps)),
-                                "goal": None, "kind": "random", "seed": seed, "steps": steps})
-    return write_configuration_files(model, model_rel, ann, coverage, per_config,
-                                     {c: v[0] for c, v in CONFIGS.items()},
-                                     lambda cfg: header_for(model, b, cfg),
-                                     Path(spec_dir) / "schemas" / "vectors_lc.schema.json", out_dir, problems)
+PART = LevelCrossing()
