@@ -27,6 +27,8 @@ set_property(GLOBAL APPEND PROPERTY JOB_POOLS railproof_spin=2)
 set(_spin_outputs)
 set(_vector_outputs)
 foreach(cap ${RAILPROOF_CAPABILITIES})
+  # the parts the capability's models share (models/include/<cap>_*.pml)
+  file(GLOB _shared CONFIGURE_DEPENDS ${RAILPROOF_SOURCE_DIR}/models/include/${cap}_*.pml)
   foreach(model ${RAILPROOF_CAP_${cap}_MODELS})
     set(_pml ${RAILPROOF_SOURCE_DIR}/models/${model}.pml)
     set(_params ${RAILPROOF_GEN_DIR}/models/${cap}_params.pml)
@@ -35,7 +37,7 @@ foreach(cap ${RAILPROOF_CAPABILITIES})
       OUTPUT ${_spin_json}
       COMMAND ${RAILPROOF_TESTGEN} verify --model ${_pml} --params ${RAILPROOF_GEN_DIR}/models
               --work ${CMAKE_BINARY_DIR}/spin/${model}/verify --out ${_spin_json} --jobs 2
-      DEPENDS ${_pml} ${_params} ${_tg_spin}
+      DEPENDS ${_pml} ${_shared} ${_params} ${_tg_spin}
       COMMENT "SPIN: exhaustive verification of models/${model}.pml (properties, mutants)"
       JOB_POOL railproof_spin VERBATIM)
     set(_vec ${RAILPROOF_VECTOR_DIR}/${model}.jsonl)
@@ -45,7 +47,7 @@ foreach(cap ${RAILPROOF_CAPABILITIES})
       COMMAND ${RAILPROOF_TESTGEN} vectors --model ${_pml} --params ${RAILPROOF_GEN_DIR}/models
               --spec ${RAILPROOF_SOURCE_DIR}/spec --work ${CMAKE_BINARY_DIR}/spin/${model}/vectors
               --out ${RAILPROOF_VECTOR_DIR} --jobs 2
-      DEPENDS ${_pml} ${_params} ${_tg_spin} ${_tg_engine} ${_tg}/capabilities/${cap}.py
+      DEPENDS ${_pml} ${_shared} ${_params} ${_tg_spin} ${_tg_engine} ${_tg}/capabilities/${cap}.py
               ${RAILPROOF_SOURCE_DIR}/spec/schemas/vectors_${cap}.schema.json ${_just}
       COMMENT "testgen: trap, boundary and random-walk vectors from models/${model}.pml"
       JOB_POOL railproof_spin VERBATIM)

@@ -19,8 +19,9 @@ The check (every finding printed as ``file: entry: reason``; any error exits 1):
   sources, and every RAILPROOF_FAULT(...) in cpp/runtime is registered under its capability;
 - proofs/<name>/ exists exactly when the registry says the capability has proofs;
 - nothing is orphaned: every spec/requirements, spec/parameters and spec/justifications file,
-  every model, every vector schema, every proofs/ folder and every cpp/runtime or cpp/offline
-  folder belongs to a registered capability (or to the shared modules listed in SHARED).
+  every model and shared model part (models/include/<cap>_*.pml), every vector schema, every
+  proofs/ folder and every cpp/runtime or cpp/offline folder belongs to a registered
+  capability (or to the shared modules listed in SHARED).
 """
 from __future__ import annotations
 
@@ -297,6 +298,10 @@ class Checker:
               lambda p: p.name[len("vectors_"):-len(".schema.json")] in names, "vector schema")
         models = {m.name for m in self.reg.models}
         claim(sorted((self.repo / "models").glob("*.pml")), lambda p: p.stem in models, "model")
+        # shared parts of a capability's models: models/include/<cap>_*.pml
+        claim(sorted((self.repo / "models" / "include").glob("*")),
+              lambda p: p.suffix == ".pml" and p.stem.split("_")[0] in names and "_" in p.stem,
+              "shared model part (models/include/<cap>_*.pml)")
         claim(sorted(p for p in (self.repo / "proofs").glob("*") if p.is_dir()),
               lambda p: p.name in names, "proof folder")
         for kind in ("runtime", "offline"):

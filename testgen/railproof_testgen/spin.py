@@ -213,14 +213,48 @@ def _run(cmd, cwd, timeout=None):
     raise AssertionError("unreachable")
 
 
+# A model may include parts it shares with another model of its capability; they live in
+# models/include/<cap>_*.pml (not models of their own) and are staged beside the model.
+INCLUDE_DIR = "include"
+_INCLUDE = re.compile(r'^\s*#\s*include\s+"([^"]+)"', re.M)
+
+
+def shared_includes(model: Path) -> list:
+    """The files of models/include/ that the model includes (its shared parts)."""
+    model = Path(model)
+    inc_dir = model.parent / INCLUDE_DIR
+    names = _INCLUDE.findall(model.read_text(encoding="utf-8"))
+    return [inc_dir / n for n in names if (inc_dir / n).is_file()]
+
+
+def model_text(model: Path) -> str:
+    """The model and the shared parts it includes, as one text (for what testgen reads from
+    the model's source, e.g. its local bounds)."""
+    return "\n".join(Path(f).read_text(encoding="utf-8") for f in [Path(model), *shared_includes(model)])
+
+
+def params_file(params_dir: Path, model: Path) -> Path:
+    """The generated parameter header of a model: <cap>_params.pml of its capability (a model
+    is named <cap> or <cap>_<part>, spec/capabilities.yaml)."""
+    cap = Path(model).stem.split("_")[0]
+    path = Path(params_dir) / f"{cap}_params.pml"
+    if not path.is_file():
+        raise PipelineError(f"{path}: missing: the generated parameters of {Path(model).name} "
+                            f"(spec/parameters/{cap}.yaml)")
+    return path
+
+
 def stage(model: Path, params_dir: Path, workdir: Path, extra_claim: str | None = None, texts=None):
-    """A fresh workdir with a copy of the model (extra_claim, a claim, appended to it), its
-    generated includes (the *.pml of params_dir) and the files of texts ({name: text})."""
+    """A fresh workdir with a copy of the model (extra_claim, a claim, appended to it), the
+    shared parts it includes (models/include), its generated includes (the *.pml of params_dir)
+    and the files of texts ({name: text})."""
     workdir = Path(workdir)
     if workdir.exists():
         shutil.rmtree(workdir)
     workdir.mkdir(parents=True)
     shutil.copy2(model, workdir / Path(model).name)
+    for inc in shared_includes(model):
+        shutil.copy2(inc, workdir / inc.name)
     if extra_claim:
         with open(workdir / Path(model).name, "a", encoding="utf-8") as f:
             f.write("\n" + extra_claim)
@@ -440,7 +474,7 @@ def verify(model: Path, params_dir: Path, workdir: Path, out_json: Path, jobs: i
     model = Path(model)
     ann = parse_annotations(model)
     version = spin_version()
-    bounds = read_bounds(next(Path(params_dir).glob(f"{model.stem}_params.pml")))
+    bounds = read_bounds(params_file(params_dir, model))
     # every default-configuration property is also verified in every boundary variant
     runs = [(p, c) for p in ann.properties for c in p.configs]
     runs += [(p, v.define) for v in ann.variants for p in ann.properties if p.config is None]

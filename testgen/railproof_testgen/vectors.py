@@ -195,8 +195,8 @@ class Target:
 
 
 def capability_part(spec_dir: Path, model: Path):
-    """(capability name, PART of capabilities/<name>.py) of the capability the registry
-    lists the model under."""
+    """(capability name, part) of the capability the registry lists the model under: the PART of
+    capabilities/<name>.py, or its PARTS[<model name>] where a capability has several models."""
     reg = registry_mod.load(spec_dir)
     cap = reg.of_model(model)
     if cap is None:
@@ -207,7 +207,14 @@ def capability_part(spec_dir: Path, model: Path):
         if exc.name != f"{__package__}.capabilities.{cap.name}":
             raise
         raise SpecError(cap.vector_part, cap.name, "missing: the capability's part of vector generation") from None
-    part = getattr(mod, "PART", None)
+    # one part for the capability (PART), or one per model of the capability (PARTS, by name)
+    parts = getattr(mod, "PARTS", None)
+    if parts is not None:
+        part = parts.get(Path(model).stem)
+        if part is None:
+            raise SpecError(cap.vector_part, "PARTS", f"no part for the model {Path(model).stem}")
+    else:
+        part = getattr(mod, "PART", None)
     if not isinstance(part, Part):
         raise SpecError(cap.vector_part, "PART", "must be an instance of railproof_testgen.vectors.Part")
     return cap.name, part
@@ -307,7 +314,7 @@ class Generation:
             if v.define not in known:
                 raise SpecError(self.model, v.define, f"variant in which capability {capability} generates "
                                                       f"no vectors (capabilities/{capability}.py)")
-        bounds = part.bounds(self.model, self.params_dir / f"{self.model.stem}_params.pml")
+        bounds = part.bounds(self.model, spin_mod.params_file(self.params_dir, self.model))
         self.target = Target(self.model, ann, bounds, spin_mod.spin_version())
         self.schema = self.spec_dir / "schemas" / f"vectors_{capability}.schema.json"
         self.justification_file = f"spec/justifications/{capability}.yaml"

@@ -1,5 +1,5 @@
 """Tests of the level-crossing part of vector generation (railproof_testgen.capabilities.lc,
-models/lc.pml, spec/schemas/vectors_lc.schema.json). The C++ conformance runner
+models/lc.pml and models/lc_gnss.pml, spec/schemas/vectors_lc.schema.json). The C++ conformance runner
 (railproof_conformance_lc) is the behavioural check of the vectors; these tests check the parser,
 the conversion to absolute times and C++ units, the ETA classes, header and schema on hand-made
 model output, and that the vectors of a build (RAILPROOF_RESULTS_DIR) have a file per
@@ -13,12 +13,14 @@ import pytest
 
 from railproof_testgen import spin, vectors
 from railproof_testgen.capabilities import lc
-from railproof_testgen.capabilities.lc import PART
+from railproof_testgen.capabilities.lc import PARTS
 from railproof_testgen.errors import PipelineError
 from vector_results import vector_set
 
 REPO = Path(__file__).resolve().parents[2]
-MODEL = REPO / "models" / "lc.pml"
+MODEL = REPO / "models" / "lc.pml"            # the on-board-requested warning
+MODEL_GNSS = REPO / "models" / "lc_gnss.pml"  # the GNSS-time pre-armed crossings
+PART, PART_GNSS = PARTS["lc"], PARTS["lc_gnss"]
 SCHEMA = REPO / "spec" / "schemas" / "vectors_lc.schema.json"
 
 # the seeded C++ faults of cpp/runtime/lc/src/onboard/crossing_protection.cpp, cpp/runtime/lc/src/wayside/crossing_controller.cpp
@@ -32,38 +34,51 @@ BOUNDS = {"track": 12, "vmax": 2, "lc_a": 8, "lc_b": 10, "train_len": 1, "statio
           "gnss_faults": 2}
 
 
-def test_annotations_of_the_level_crossing_model():
-    ann = spin.parse_annotations(MODEL)
-    props = {p.name: p for p in ann.properties}
+def test_annotations_of_the_level_crossing_models():
+    anns = {m: spin.parse_annotations(m) for m in (MODEL, MODEL_GNSS)}
+    props = {}
+    for ann in anns.values():
+        for p in ann.properties:  # a property of both models is the same claim, each with its configurations
+            props.setdefault(p.name, []).append(p)
     assert {"REQ_LC_003_occupancy", "REQ_LC_003_fresh", "REQ_LC_007_end", "REQ_LC_007_ends", "REQ_LC_002_request",
             "REQ_LC_006_controller", "REQ_LC_015_no_braking", "REQ_LC_009_departure", "REQ_LC_008_start",
             "REQ_LC_013_clock", "REQ_LC_010_later"} == set(props)
-    for name, p in props.items():  # named by the requirement it verifies, in named configurations
-        assert name[:10].replace("_", "-") in p.requirements
-        assert p.configs and set(p.configs) <= CONFIG_NAMES
+    configs = {name: [c for p in ps for c in p.configs] for name, ps in props.items()}
+    for name, ps in props.items():  # named by the requirement it verifies, in named configurations
+        assert all(name[:10].replace("_", "-") in p.requirements for p in ps)
+        assert configs[name] and set(configs[name]) <= CONFIG_NAMES
+    # each model is checked in its own configurations only
+    assert {c for p in anns[MODEL].properties for c in p.configs} == {"ONBOARD", "LONG_WARNING", "TWO_TRAINS",
+                                                                      "FAIR", "HEALTHY"}
+    assert {c for p in anns[MODEL_GNSS].properties for c in p.configs} == {"GNSS", "GNSS_CLOCK", "GNSS_FAIR"}
     # the occupancy property holds in both variants, the liveness is a bounded response under fairness
-    assert {"ONBOARD", "GNSS"} <= set(props["REQ_LC_003_occupancy"].configs)
-    assert set(props["REQ_LC_007_ends"].configs) >= {"FAIR", "GNSS_FAIR"}
-    assert props["REQ_LC_015_no_braking"].configs == ["HEALTHY"]
-    covered = {r for p in ann.properties for r in p.requirements}
+    assert {"ONBOARD", "GNSS"} <= set(configs["REQ_LC_003_occupancy"])
+    assert set(configs["REQ_LC_007_ends"]) >= {"FAIR", "GNSS_FAIR"}
+    assert configs["REQ_LC_015_no_braking"] == ["HEALTHY"]
+    covered = {r for ps in props.values() for p in ps for r in p.requirements}
     assert covered == {f"REQ-LC-{n:03d}" for n in range(1, 16)}
-    mutants = {m.name: m for m in ann.mutants}
+    mutants = {m.name: (m, model) for model, ann in anns.items() for m in ann.mutants}
     assert {f"MUTANT_{f}" for f in CPP_FAULTS} <= set(mutants)
     assert len(mutants) > len(CPP_FAULTS)
     for f in CPP_FAULTS:  # each mutant names the C++ fault it mirrors
-        assert f"FAULT_LC_{f}" in mutants[f"MUTANT_{f}"].text
-    for m in ann.mutants:  # checked in one configuration where its property is verified
-        assert m.violates in props and m.config in props[m.violates].configs, m.name
-    assert len({g.number for g in ann.goals}) == len(ann.goals)
-    assert all(g.requirements and g.label for g in ann.goals)
+        assert f"FAULT_LC_{f}" in mutants[f"MUTANT_{f}"][0].text
+    for m, model in mutants.values():  # checked in one configuration of its model where its property is verified
+        own = {p.name: p for p in anns[model].properties}
+        assert m.violates in own and m.config in own[m.violates].configs, m.name
+    goals = [g for ann in anns.values() for g in ann.goals]
+    assert len({g.number for g in goals}) == len(goals)  # goal numbers unique over both models
+    assert all(g.requirements and g.label for g in goals)
     # every file gets trap vectors
-    assert {g.config for g in ann.goals} == {c.define for c in PART.configurations}
+    assert {g.config for g in anns[MODEL].goals} == {c.define for c in PART.configurations}
+    assert {g.config for g in anns[MODEL_GNSS].goals} == {c.define for c in PART_GNSS.configurations}
 
 
 def test_model_local_bounds_are_read_from_the_model():
+    """The local bounds are in the parts both models share (models/include/lc_shared.pml)."""
     local = lc.model_local_defaults(MODEL)
     assert set(local) | {"dwell_ticks"} == set(lc.LOCAL)
     assert local["conf_age_ticks"] == 0 and local["lead_ticks"] >= 1 and local["gnss_faults"] >= 1
+    assert lc.model_local_defaults(MODEL_GNSS) == local
 
 
 def _model_eta2(d, v, vmax=2):
@@ -208,12 +223,14 @@ def test_malformed_model_output_is_an_error():
 
 
 def _header(config=None):
-    return PART.header(vectors.Target(MODEL, spin.parse_annotations(MODEL), BOUNDS, "test"), config)
+    part, model = (PART_GNSS, MODEL_GNSS) if config and config.startswith("GNSS") else (PART, MODEL)
+    return part.header(vectors.Target(model, spin.parse_annotations(model), BOUNDS, "test"), config)
 
 
 def test_header_records_the_configuration_and_units():
     h, hl, hg = _header(), _header("LONG_WARNING"), _header("GNSS")
     assert h["configuration"] == "default" and h["variant"] == "ONBOARD" and hg["variant"] == "GNSS"
+    assert h["model"] == "models/lc.pml" and hg["model"] == "models/lc_gnss.pml"
     p = h["parameters"]
     assert [c["warning_time_ms"] for c in p["crossings"]] == [30_000, 30_000]
     assert [c["warning_time_ms"] for c in hl["parameters"]["crossings"]] == [40_000, 40_000]
@@ -235,7 +252,7 @@ def test_schema_accepts_good_and_rejects_bad_records():
     text = vectors.schema_checked_jsonl(SCHEMA, good, "lc.jsonl")
     assert [json.loads(ln) for ln in text.splitlines()] == good
     vectors.schema_checked_jsonl(SCHEMA, [_header("GNSS"), _vector("GNSS", GNSS_RUN, "LC-TRAP-GNSS-G60")],
-                                 "lc.gnss.jsonl")
+                                 "lc_gnss.jsonl")
 
     def broken(edit):
         lines = copy.deepcopy(good)
@@ -272,27 +289,30 @@ def test_schema_accepts_good_and_rejects_bad_records():
     assert len(str(info.value)) < 500
 
 
-def test_every_configuration_has_its_file():
-    vs = vector_set("lc")
-    assert sorted(vs.files) == sorted(f"lc{c.suffix}.jsonl" for c in PART.configurations)
-    for c in PART.configurations:
-        name = f"lc{c.suffix}.jsonl"
+@pytest.mark.parametrize("model, part", [("lc", PART), ("lc_gnss", PART_GNSS)])
+def test_every_configuration_has_its_file(model, part):
+    vs = vector_set(model)
+    assert sorted(vs.files) == sorted(f"{model}{c.suffix}.jsonl" for c in part.configurations)
+    for c in part.configurations:
+        name = f"{model}{c.suffix}.jsonl"
         header = vs.header(name)
+        assert header["model"] == f"models/{model}.pml"
         assert header["configuration"] == c.name and header["variant"] == lc.VARIANT[c.define][0]
         walks = [v for v in vs.vectors(name) if v["kind"] == "random"]
-        assert walks and all(len(v["steps"]) == PART.walk_length(header["parameters"]["model_bounds"], c.define)
+        assert walks and all(len(v["steps"]) == part.walk_length(header["parameters"]["model_bounds"], c.define)
                              for v in walks)
         for v in vs.vectors(name):
             assert v["id"].startswith(f"LC-{v['kind'].upper()}-{c.tag}"), v["id"]
     goals = {g["id"]: g for g in vs.coverage["goals"]}
-    assert all(g["configuration"] in {c.name for c in PART.configurations} for g in goals.values())
+    assert all(g["configuration"] in {c.name for c in part.configurations} for g in goals.values())
 
 
 def test_vectors_follow_the_design_note():
     """Invariants of design note §3-§5 on every step of every vector (the exact values are the
     C++ conformance runner's check)."""
-    vs = vector_set("lc")
-    for name, lines in vs.files.items():
+    files = {**vector_set("lc").files, **vector_set("lc_gnss").files}
+    assert any(n.startswith("lc_gnss") for n in files) and "lc.jsonl" in files
+    for name, lines in files.items():
         h = lines[0]["parameters"]
         near = {c["id"]: c["near_mm"] for c in h["crossings"]}
         offset = h["protection"]["protection_offset_mm"]
@@ -370,7 +390,7 @@ def test_boundary_vectors_hit_the_boundaries():
     assert s["onboard"]["out"]["states"][0] == "REQUESTED"
     assert any(r["status"] == "CLOSED" for r in s["onboard"]["in"]["reports"])
     # GNSS G60: autonomous start exactly at the stored start time
-    gv = vs.by_goal("lc.gnss.jsonl")
+    gv = vector_set("lc_gnss").by_goal("lc_gnss.jsonl")
     s = gv["G60"]["steps"][-1]["controllers"][0]
     assert s["out"]["state"] == "WARNING" and s["out"]["pending"]["start_ms"] == gv["G60"]["steps"][-1]["t_ms"]
     # GNSS G100: the train leaves exactly at t_dep on the signal

@@ -1,5 +1,6 @@
-"""The level-crossing part of vector generation: models/lc.pml (spec/design/lc.md §3-§6: the
-on-board crossing function, the crossing controllers and the centre scheduler); the engine is
+"""The level-crossing part of vector generation: models/lc.pml and models/lc_gnss.pml
+(spec/design/lc.md §3-§6: the on-board crossing function, the crossing controllers and the
+centre scheduler), one part per model (PARTS); the engine is
 vectors.py. Each goal is searched in the configuration its annotation names; random walks in
 configuration WALK (at most MODEL_CYCLES ticks; GNSS runs end at the model's horizon). One
 file per configuration, each with a header that records it:
@@ -7,8 +8,8 @@ file per configuration, each with a header that records it:
   lc.jsonl               ONBOARD, one train (the model's default configuration)
   lc.long_warning.jsonl  ONBOARD, design warning time one tick longer
   lc.two_trains.jsonl    ONBOARD, a second train requesting crossing A
-  lc.gnss.jsonl          GNSS-time pre-armed crossings (losses, delays, barriers)
-  lc.gnss_clock.jsonl    GNSS with GNSS outages and clock faults
+  lc_gnss.jsonl          GNSS-time pre-armed crossings (losses, delays, barriers), models/lc_gnss.pml
+  lc_gnss.clock.jsonl    GNSS with GNSS outages and clock faults
 
 Units (header "unit_scales"): a model tick is TICK_MS ms, a model cell CELL_MM mm (positions
 are half-cells), a speed unit (cells per tick) SPEED_MM_S mm/s, the acceleration 1 cell/tick²
@@ -28,6 +29,7 @@ import re
 from pathlib import Path
 
 from ..errors import PipelineError, SpecError
+from ..spin import model_text
 from ..vectors import Configuration, Part, model_bounds
 
 TICK_MS = 10_000
@@ -86,9 +88,10 @@ _RX = {
 
 # ---- bounds and the header ---------------------------------------------------------------------
 def model_local_defaults(model: Path) -> dict:
-    """The model-local bounds (#ifndef MODEL_X / #define MODEL_X n) of the model file."""
+    """The model-local bounds (#ifndef MODEL_X / #define MODEL_X n) of the model and the shared
+    parts it includes (models/include/lc_shared.pml)."""
     out = {}
-    for name, value in _LOCAL_DEFAULT.findall(Path(model).read_text(encoding="utf-8")):
+    for name, value in _LOCAL_DEFAULT.findall(model_text(model)):
         key = name.lower()
         if key in LOCAL:
             try:
@@ -377,13 +380,12 @@ def gnss_steps(ticks, b: dict, config):
 
 # ---- the part -----------------------------------------------------------------------------------
 class LevelCrossing(Part):
+    """models/lc.pml: the on-board-requested warning."""
     prefix = "LC"
     configurations = (
         Configuration(None, walks=1),
         Configuration("LONG_WARNING", suffix=".long_warning", tag="LONGWARN-", walks=5),
         Configuration("TWO_TRAINS", suffix=".two_trains", tag="TWOTRAINS-", walks=5),
-        Configuration("GNSS", suffix=".gnss", tag="GNSS-", walks=5),
-        Configuration("GNSS_CLOCK", suffix=".gnss_clock", tag="GNSSCLOCK-", walks=5),
     )
 
     def bounds(self, model, params_pml):
@@ -520,4 +522,12 @@ class LevelCrossing(Part):
             parameters=params)
 
 
-PART = LevelCrossing()
+class LevelCrossingGnss(LevelCrossing):
+    """models/lc_gnss.pml: the GNSS-time pre-armed crossings (same units, parser and steps)."""
+    configurations = (
+        Configuration("GNSS", tag="GNSS-", walks=5),
+        Configuration("GNSS_CLOCK", suffix=".clock", tag="GNSSCLOCK-", walks=5),
+    )
+
+
+PARTS = {"lc": LevelCrossing(), "lc_gnss": LevelCrossingGnss()}

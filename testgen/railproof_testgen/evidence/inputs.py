@@ -26,6 +26,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from .. import spec as spec_mod
+from .. import spin as spin_mod
 from ..errors import PipelineError, SpecError
 from . import junit
 
@@ -226,13 +227,18 @@ def load_spin(inp: Inputs) -> None:
 
 def _copy_model_source(inp: Inputs, model) -> None:
     """A verbatim copy of the checked model (inputs/source/models/...) when the result names
-    a file inside the source tree."""
+    a file inside the source tree, with the shared parts it includes (models/include/...), so
+    that the package holds everything a replay of the model needs."""
     if not isinstance(model, str) or not model or model in inp.model_copies:
         return
     root = inp.repo_root.resolve()
     path = (inp.repo_root / model).resolve()
     if root in path.parents and path.is_file():
         inp.model_copies[model] = inp.add(path, f"source/{path.relative_to(root).as_posix()}")
+        for inc in spin_mod.shared_includes(path):
+            rel = inc.resolve().relative_to(root).as_posix()
+            if rel not in inp.model_copies:
+                inp.model_copies[rel] = inp.add(inc.resolve(), f"source/{rel}")
 
 
 def load_vectors(inp: Inputs) -> None:

@@ -32,6 +32,7 @@
 // "railproof-conformance-lc: vectors mismatched: K of N" or "...: error: <reason>".
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <atomic>
 #include <cstddef>
@@ -63,7 +64,12 @@ namespace ws = railproof::lc::wayside;
 namespace br = railproof::br;
 using json = nlohmann::json;
 
-constexpr const char* kModel = "models/lc.pml";
+// the two level-crossing models: the on-board-requested warning and the GNSS-time crossings
+constexpr std::array<const char*, 2> kModels{"models/lc.pml", "models/lc_gnss.pml"};
+
+bool IsLcModel(const std::string& model) {
+  return std::any_of(kModels.begin(), kModels.end(), [&](const char* m) { return model == m; });
+}
 constexpr const char* kUnits = "model tick = 10000 ms, model cell = 100000 mm (positions in half-cells)";
 constexpr std::int64_t kTickMs = 10000;
 
@@ -296,8 +302,8 @@ bool Load(const fs::path& dir, std::string& error) {
   error = rcli::ReadVectorDirectory(
       dir, "lc",
       [](const std::string& file, const json& obj) -> std::string {
-        if (obj.value("kind", "") != "header" || obj.value("model", "") != kModel || !obj.contains("parameters")) {
-          return "first line is not a " + std::string(kModel) + " vector header";
+        if (obj.value("kind", "") != "header" || !IsLcModel(obj.value("model", "")) || !obj.contains("parameters")) {
+          return "first line is not a models/lc.pml or models/lc_gnss.pml vector header";
         }
         if (obj.value("units", "") != kUnits) {
           return "header units must be \"" + std::string(kUnits) + "\"";
