@@ -38,7 +38,7 @@ Output (deterministic: sorted keys and lists, paths relative to REPO_ROOT or to
 RESULTS_DIR, no time stamps)::
 
     {"schema": "railproof/trace/1",
-     "requirements": [{"id", "area", "title", "sil", "source", "hazards", "verification",
+     "requirements": [{"id", "area", "capability", "title", "sil", "source", "hazards", "verification",
                        "implemented_by": "runtime" | "offline",
                      "links": {"model": [{"property", "verdict", "model"}],
                                  "goals": ["G17", ...], "vectors": ["TG-TRAP-017", ...],
@@ -59,6 +59,7 @@ import re
 import sys
 from pathlib import Path
 
+from . import registry as registry_mod
 from .errors import SpecError
 from .validate import REQ_ID, Report, check_spec
 
@@ -893,6 +894,19 @@ class Tracer:
         for w in spec_report.warnings:
             self.warn(Path(w.file), w.entry, w.reason)
         self.model = model
+        # every requirement belongs to the capability of its area (spec/capabilities.yaml)
+        try:
+            reg = registry_mod.load(self.spec_dir)
+        except SpecError as exc:
+            self.error(Path(exc.file), exc.entry, exc.reason)
+            return None
+        self.capability = {}
+        for rid, r in sorted(model["requirements"].items()):
+            cap = reg.of_area(r["area"])
+            if cap is None:
+                self.error(self.rel_spec(r["file"]), rid, f"area {r['area']} belongs to no capability of "
+                                                          f"{self.rel(reg.file)}")
+            self.capability[rid] = cap.name if cap else None
         self.links = {rid: {k: [] for k in LINK_KINDS} for rid in model["requirements"]}
         self.problems = {rid: [] for rid in model["requirements"]}
         self.scan_models()
@@ -923,7 +937,8 @@ class Tracer:
             by_sil[str(r.get("sil"))] = by_sil.get(str(r.get("sil")), 0) + 1
             problems = sorted(self.problems[rid])
             reqs.append({
-                "id": rid, "area": r["area"], "title": r.get("title"), "sil": r.get("sil"),
+                "id": rid, "area": r["area"], "capability": self.capability.get(rid),
+                "title": r.get("title"), "sil": r.get("sil"),
                 "source": list(r.get("source") or []), "hazards": sorted(r.get("hazards") or []),
                 "verification": list(r.get("verification") or []),
                 "implemented_by": r.get("implemented_by", "runtime"), "links": links,

@@ -388,3 +388,21 @@ def test_offline_requirement_needs_an_offline_tool(tree, trace):
     tool.write_text("// @implements REQ-TG-002\nint CheckData() { return 0; }\n", encoding="utf-8")
     r = trace(root)
     assert r.rc == 0, r.err
+
+
+def test_every_requirement_belongs_to_a_registered_capability(tree, trace):
+    """The trace names each requirement's capability (spec/capabilities.yaml); an area of no
+    capability, or no registry at all, is an error."""
+    root = tree()
+    r = trace(root)
+    assert r.rc == 0, r.err
+    data = json.loads((root / "out" / "trace.json").read_text(encoding="utf-8"))
+    assert {x["id"]: x["capability"] for x in data["requirements"]}["REQ-MB-001"] == "mb"
+    _edit(root / "spec/capabilities.yaml", "    areas: [MB]\n", "    areas: [BR]\n")
+    _edit(root / "spec/capabilities.yaml", "  - name: mb\n", "  - name: br\n")
+    r = trace(root)
+    assert r.rc == 1
+    assert r.has("spec/requirements/mb.yaml", "REQ-MB-001", "area MB belongs to no capability of")
+    (root / "spec/capabilities.yaml").unlink()
+    r = trace(root)
+    assert r.rc == 1 and "capabilities.yaml: -: file not found" in r.err
