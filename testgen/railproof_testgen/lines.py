@@ -56,6 +56,7 @@ from __future__ import annotations
 from decimal import Decimal, InvalidOperation
 from pathlib import Path
 
+from . import SPEC_DIR, add_command
 from . import spec as spec_mod
 from . import validate as vmod
 from .errors import SpecError
@@ -888,13 +889,9 @@ def run(args):
 
 
 def register(sub):
-    p = sub.add_parser(
-        "lines", help="validate spec/lines and write the line JSON for the simulation",
-        description="Check every spec/lines/*.yaml against spec/schemas/line.schema.json and "
-                    "the topology rules of spec/lines/README.md, then write OUT/<name>.json "
-                    "(schema railproof/line-json/1). Prints every finding as "
-                    "'file: entry: reason'; on any error nothing is written and the exit "
-                    "status is 1.")
-    p.add_argument("--spec", required=True, help="spec/ directory")
-    p.add_argument("--out", required=True, help="output directory (build/gen/lines)")
-    p.set_defaults(func=run)
+    add_command(sub, "lines", run, "validate spec/lines and write the line JSON for the simulation",
+                """Check every spec/lines/*.yaml against spec/schemas/line.schema.json and the
+                topology rules of spec/lines/README.md, then write OUT/<name>.json (schema
+                railproof/line-json/1). Prints every finding as 'file: entry: reason'; on any
+                error nothing is written and the exit status is 1.""",
+                spec=SPEC_DIR, out="output directory (build/gen/lines)")

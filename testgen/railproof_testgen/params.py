@@ -4,6 +4,7 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
+from . import SPEC_DIR, add_command
 from . import spec as spec_mod
 
 _IDENT = re.compile(r"^[a-z][a-z0-9_]*$")
@@ -59,7 +60,6 @@ def generate(spec_dir: Path, out_dir: Path):
 
 
 def register(sub):
-    p = sub.add_parser("gen-params", help="validate spec/ and generate parameter headers")
-    p.add_argument("--spec", required=True, help="spec/ directory")
-    p.add_argument("--out", required=True, help="output directory (build/gen)")
-    p.set_defaults(func=lambda a: generate(Path(a.spec), Path(a.out)))
+    add_command(sub, "gen-params", lambda a: generate(Path(a.spec), Path(a.out)),
+                "validate spec/ and generate parameter headers",
+                spec=SPEC_DIR, out="output directory (build/gen)")

@@ -68,6 +68,7 @@ from dataclasses import dataclass, field
 from fractions import Fraction
 from pathlib import Path
 
+from . import SPEC_DIR, add_command
 from .errors import PipelineError, SpecError
 
 SCHEMA = "railproof/proofs/1"
@@ -1005,21 +1006,19 @@ def run(args):
 
 
 def register(sub):
-    p = sub.add_parser(
-        "proofs", help="generate the SMT proof obligations and replay them with z3 and cvc5",
-        description="Generate every obligation of PROOFS/<capability>/*.smt2.in from the "
-                    "spec parameters and train types into OUT/<capability>/, decide each with "
-                    "z3 and cvc5, and write OUT/<capability>.json. Exit 1 on a disagreement, "
-                    "an unexpected verdict, unknown or timeout, or bad input.")
-    p.add_argument("--spec", required=True, help="spec/ directory")
-    p.add_argument("--proofs", required=True, help="proofs/ directory (templates)")
-    p.add_argument("--out", required=True, help="output directory (build/results/proofs)")
-    p.add_argument("--timeout", type=float, default=DEFAULT_TIMEOUT_S,
-                   help=f"time limit per solver and obligation in s (default "
-                        f"{DEFAULT_TIMEOUT_S:g})")
-    p.add_argument("--jobs", type=int, default=2, help="solver processes in parallel "
-                                                       "(default 2)")
-    p.set_defaults(func=run)
+    add_command(sub, "proofs", run,
+                "generate the SMT proof obligations and replay them with z3 and cvc5",
+                """Generate every obligation of PROOFS/<capability>/*.smt2.in from the spec
+                parameters and train types into OUT/<capability>/, decide each with z3 and
+                cvc5, and write OUT/<capability>.json. Exit 1 on a disagreement, an unexpected
+                verdict, unknown or timeout, or bad input.""",
+                spec=SPEC_DIR, proofs="proofs/ directory (templates)",
+                out="output directory (build/results/proofs)",
+                timeout={"type": float, "default": DEFAULT_TIMEOUT_S,
+                         "help": f"time limit per solver and obligation in s (default "
+                                 f"{DEFAULT_TIMEOUT_S:g})"},
+                jobs={"type": int, "default": 2, "help": "solver processes in parallel (default 2)"})
+
 
 
 if __name__ == "__main__":

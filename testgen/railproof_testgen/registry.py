@@ -33,6 +33,7 @@ from pathlib import Path
 
 import jsonschema
 
+from . import SPEC_DIR, add_command
 from . import spin as spin_mod
 from .errors import SpecError
 from .spec import load_yaml
@@ -384,12 +385,10 @@ def run(args) -> int:
 
 
 def register(sub):
-    p = sub.add_parser("registry", help="check the capability registry against the tree and write "
-                                        "what the build reads from it")
-    p.add_argument("--spec", required=True, help="spec/ directory")
-    p.add_argument("--repo", default=".", help="repository root")
-    p.add_argument("--check", action="store_true", help="check the registry against the tree")
-    p.add_argument("--cmake", help="write the CMake variables here")
-    p.add_argument("--faults-header", help="write the seeded-fault identifiers (C++) here")
-    p.add_argument("--json", help="write the registry as JSON (for the evidence)")
-    p.set_defaults(func=run)
+    add_command(sub, "registry", run,
+                "check the capability registry against the tree and write what the build reads from it",
+                spec=SPEC_DIR, repo={"default": ".", "help": "repository root"},
+                check={"action": "store_true", "help": "check the registry against the tree"},
+                cmake={"help": "write the CMake variables here"},
+                faults_header={"help": "write the seeded-fault identifiers (C++) here"},
+                json={"help": "write the registry as JSON (for the evidence)"})

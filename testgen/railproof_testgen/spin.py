@@ -35,6 +35,7 @@ from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from . import add_command
 from .errors import PipelineError, SpecError
 
 _REQ = re.compile(r"REQ-[A-Z]{2}-\d{3}")
@@ -632,13 +633,14 @@ def verify(model: Path, params_dir: Path, workdir: Path, out_json: Path, jobs: i
 
 
 def register(sub):
-    p = sub.add_parser("verify", help="model-check every named property and every mutant of a model")
-    p.add_argument("--model", required=True)
-    p.add_argument("--params", required=True, help="directory with the generated <model>_params.pml")
-    p.add_argument("--work", required=True, help="scratch directory (build tree)")
-    p.add_argument("--out", required=True, help="results JSON")
-    p.add_argument("--jobs", type=int, default=os.cpu_count() or 1)
-    p.set_defaults(func=lambda a: (verify(Path(a.model), Path(a.params), Path(a.work), Path(a.out), a.jobs), 0)[1])
+    add_command(sub, "verify",
+                lambda a: (verify(Path(a.model), Path(a.params), Path(a.work), Path(a.out), a.jobs), 0)[1],
+                "model-check every named property and every mutant of a model",
+                model={"required": True},
+                params="directory with the generated <model>_params.pml",
+                work="scratch directory (build tree)", out="results JSON",
+                jobs={"type": int, "default": os.cpu_count() or 1})
+
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -31,6 +31,7 @@ import sys
 from decimal import Decimal
 from pathlib import Path
 
+from . import SPEC_DIR, add_command
 from . import spec as spec_mod
 from . import validate as vmod
 
@@ -293,15 +294,11 @@ def run(args):
 
 
 def register(sub):
-    p = sub.add_parser(
-        "timetables", help="validate spec/timetables and write the timetable JSON",
-        description="Check every spec/timetables/*.yaml against "
-                    "spec/schemas/timetable.schema.json and the rules of "
-                    "spec/timetables/README.md (stations on the running line in running "
-                    "order, known train types, dwell times, platforms, departures in order), "
-                    "then write OUT/<name>.json (schema railproof/timetable-json/1, times in "
-                    "ms). Prints every finding as 'file: entry: reason'; on any error nothing "
-                    "is written and the exit status is 1.")
-    p.add_argument("--spec", required=True, help="spec/ directory")
-    p.add_argument("--out", required=True, help="output directory (build/gen/timetables)")
-    p.set_defaults(func=run)
+    add_command(sub, "timetables", run, "validate spec/timetables and write the timetable JSON",
+                """Check every spec/timetables/*.yaml against spec/schemas/timetable.schema.json
+                and the rules of spec/timetables/README.md (stations on the running line in
+                running order, known train types, dwell times, platforms, departures in
+                order), then write OUT/<name>.json (schema railproof/timetable-json/1, times in
+                ms). Prints every finding as 'file: entry: reason'; on any error nothing is
+                written and the exit status is 1.""",
+                spec=SPEC_DIR, out="output directory (build/gen/timetables)")

@@ -59,6 +59,7 @@ import re
 import sys
 from pathlib import Path
 
+from . import SPEC_DIR, add_command
 from . import registry as registry_mod
 from .errors import SpecError
 from .validate import REQ_ID, Report, check_spec
@@ -1015,17 +1016,12 @@ def run(args):
 
 
 def register(sub):
-    p = sub.add_parser(
-        "trace", help="check requirement traceability and write trace.json",
-        description="Link every requirement to model properties, vectors, code, tests, "
-                    "proofs and analysis results; fail on dangling references, violated "
-                    "properties, surviving mutants, unjustified unreachable goals and "
-                    "unverified requirements.")
-    p.add_argument("--spec", required=True, help="spec/ directory")
-    p.add_argument("--src", required=True, help="repository root (models/, cpp/, proofs/)")
-    p.add_argument("--results", required=True, help="results directory (spin/, vectors/, "
-                                                     "analysis/)")
-    p.add_argument("--out", required=True, help="trace.json to write")
-    p.add_argument("--allow-missing-results", action="store_true",
-                   help="missing results directories are warnings (before the pipeline ran)")
-    p.set_defaults(func=run)
+    add_command(sub, "trace", run, "check requirement traceability and write trace.json",
+                """Link every requirement to model properties, vectors, code, tests, proofs and
+                analysis results; fail on dangling references, violated properties, surviving
+                mutants, unjustified unreachable goals and unverified requirements.""",
+                spec=SPEC_DIR, src="repository root (models/, cpp/, proofs/)",
+                results="results directory (spin/, vectors/, analysis/)", out="trace.json to write",
+                allow_missing_results={"action": "store_true",
+                                       "help": "missing results directories are warnings (before "
+                                               "the pipeline ran)"})

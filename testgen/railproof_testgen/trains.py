@@ -22,6 +22,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from . import SPEC_DIR, add_command
 from . import spec as spec_mod
 from . import validate as vmod
 from .errors import SpecError
@@ -125,13 +126,10 @@ def run(args):
 
 
 def register(sub):
-    p = sub.add_parser(
-        "trains", help="validate spec/trains and write the train JSON",
-        description="Check every spec/trains/*.yaml and spec/trains/mutants/*.yaml against "
-                    "spec/schemas/train.schema.json and the design rule REQ-BR-010 (not "
-                    "enforced for the negative-test types in mutants/), then write "
-                    "OUT/<name>.json and OUT/mutants/<name>.json (schema "
-                    "railproof/train-json/1). On any error nothing is written, exit 1.")
-    p.add_argument("--spec", required=True, help="spec/ directory")
-    p.add_argument("--out", required=True, help="output directory (build/gen/trains)")
-    p.set_defaults(func=run)
+    add_command(sub, "trains", run, "validate spec/trains and write the train JSON",
+                """Check every spec/trains/*.yaml and spec/trains/mutants/*.yaml against
+                spec/schemas/train.schema.json and the design rule REQ-BR-010 (not enforced
+                for the negative-test types in mutants/), then write OUT/<name>.json and
+                OUT/mutants/<name>.json (schema railproof/train-json/1). On any error nothing
+                is written, exit 1.""",
+                spec=SPEC_DIR, out="output directory (build/gen/trains)")

@@ -40,6 +40,7 @@ from pathlib import Path
 
 import jsonschema
 
+from . import SPEC_DIR, add_command
 from . import spec as spec_mod
 from .errors import SpecError
 
@@ -634,17 +635,15 @@ def run(args):
 
 
 def register(sub):
-    p = sub.add_parser(
-        "validate", help="check spec/ against its JSON schemas and cross-references",
-        description="Validate every file of spec/{requirements,hazards,assumptions,"
-                    "parameters,justifications,lines,trains,timetables} (YAML) and "
-                    "spec/{scenarios,wheelrail} (JSON) against spec/schemas and check IDs, "
-                    "references, the line topology rules and what each data file names in "
-                    "the others. Prints every finding as 'file: entry: reason'; exit 1 on "
-                    "any error.")
-    p.add_argument("--spec", required=True, help="spec/ directory")
-    p.add_argument("--data", action="append", default=[], metavar="FILE",
-                   help="also check this scenario or wheel-rail scenario JSON (for example "
-                        "one written by hand for line_sim or wheelrail_sim) against the "
-                        "spec; repeatable")
-    p.set_defaults(func=run)
+    add_command(sub, "validate", run, "check spec/ against its JSON schemas and cross-references",
+                """Validate every file of
+                spec/{requirements,hazards,assumptions,parameters,justifications,lines,trains,timetables}
+                (YAML) and spec/{scenarios,wheelrail} (JSON) against spec/schemas and check
+                IDs, references, the line topology rules and what each data file names in the
+                others. Prints every finding as 'file: entry: reason'; exit 1 on any
+                error.""",
+                spec=SPEC_DIR,
+                data={"action": "append", "default": [], "metavar": "FILE",
+                      "help": "also check this scenario or wheel-rail scenario JSON (for example one "
+                              "written by hand for line_sim or wheelrail_sim) against the spec; "
+                              "repeatable"})

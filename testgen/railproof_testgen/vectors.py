@@ -43,7 +43,7 @@ from pathlib import Path
 
 import jsonschema
 
-from . import __version__
+from . import __version__, add_command
 from . import registry as registry_mod
 from . import spin as spin_mod
 from .errors import PipelineError, SpecError
@@ -509,16 +509,17 @@ def generate(model: Path, params_dir: Path, spec_dir: Path, workdir: Path, out_d
 
 
 def register(sub):
-    p = sub.add_parser("vectors", help="derive conformance vectors (trap goals, boundaries, random walks)")
-    p.add_argument("--model", required=True)
-    p.add_argument("--params", required=True, help="directory with the generated <model>_params.pml")
-    p.add_argument("--spec", required=True, help="spec/ directory (registry, schemas, justifications)")
-    p.add_argument("--work", required=True)
-    p.add_argument("--out", required=True, help="output directory for <model>*.jsonl and <model>.coverage.json")
-    p.add_argument("--walks", type=int, default=50, help="random walks in the default configuration")
-    p.add_argument("--walk-steps", type=int, default=None,
-                   help="length of each random walk in SPIN statements, for models whose walks are bounded "
-                        "that way (default: the capability's)")
-    p.add_argument("--jobs", type=int, default=os.cpu_count() or 1)
-    p.set_defaults(func=lambda a: (generate(Path(a.model), Path(a.params), Path(a.spec), Path(a.work),
-                                            Path(a.out), a.walks, a.walk_steps, a.jobs), 0)[1])
+    add_command(sub, "vectors",
+                lambda a: (generate(Path(a.model), Path(a.params), Path(a.spec), Path(a.work),
+                                    Path(a.out), a.walks, a.walk_steps, a.jobs), 0)[1],
+                "derive conformance vectors (trap goals, boundaries, random walks)",
+                model={"required": True},
+                params="directory with the generated <model>_params.pml",
+                spec="spec/ directory (registry, schemas, justifications)",
+                work={"required": True},
+                out="output directory for <model>*.jsonl and <model>.coverage.json",
+                walks={"type": int, "default": 50, "help": "random walks in the default configuration"},
+                walk_steps={"type": int, "default": None,
+                            "help": "length of each random walk in SPIN statements, for models whose "
+                                    "walks are bounded that way (default: the capability's)"},
+                jobs={"type": int, "default": os.cpu_count() or 1})
