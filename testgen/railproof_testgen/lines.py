@@ -851,16 +851,8 @@ def check_lines(spec_dir, report):
 
 def build(spec_dir):
     """(outputs, report) for spec_dir: all line files checked, references resolved."""
-    report = vmod.Report()
-    spec_dir = Path(spec_dir)
-    if not (spec_dir / SUB).is_dir():
-        report.error(spec_dir / SUB, "-", "line directory not found")
-        return {}, report
-    outputs, refs = check_lines(spec_dir, report)
-    if not line_files(spec_dir) and not report.errors:
-        report.error(spec_dir / SUB, "-", "no line files (*.yaml)")
-    vmod.check_assumption_refs(spec_dir, refs, report)
-    return outputs, report
+    return vmod.checked_directory(spec_dir, SUB, "line", check_lines,
+                                  lambda _outputs: line_files(spec_dir))
 
 
 def generate(spec_dir, out_dir):
@@ -873,19 +865,15 @@ def generate(spec_dir, out_dir):
     return sorted(outputs)
 
 
+def _converted(name, obj, path):
+    rls = obj["running_lines"]
+    return (f"{name}: {len(rls)} running line(s) ({', '.join(r['id'] for r in rls)}), "
+            f"{_m(rls[0]['length_mm'])} m, {sum(len(r['blocks_mm']) - 1 for r in rls)} virtual "
+            f"blocks -> {path}")
+
+
 def run(args):
-    spec_dir, out_dir = Path(args.spec), Path(args.out)
-    outputs, report = build(spec_dir)
-    if vmod.failed(report, "lines", spec_dir / SUB):
-        return 1
-    for name, obj in sorted(outputs.items()):
-        spec_mod.write_atomic(out_dir / f"{name}.json", spec_mod.render_json(obj))
-        rls = obj["running_lines"]
-        print(f"lines: {name}: {len(rls)} running line(s) "
-              f"({', '.join(r['id'] for r in rls)}), {_m(rls[0]['length_mm'])} m, "
-              f"{sum(len(r['blocks_mm']) - 1 for r in rls)} virtual blocks "
-              f"-> {out_dir / (name + '.json')}")
-    return 0
+    return vmod.convert(SUB, args, build, _converted)
 
 
 def register(sub):

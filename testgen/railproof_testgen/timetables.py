@@ -280,17 +280,12 @@ def build(spec_dir):
     return outputs, report
 
 
+def _converted(name, obj, path):
+    return f"{name}: {len(obj['services'])} services on line {obj['line']} -> {path}"
+
+
 def run(args):
-    spec_dir, out_dir = Path(args.spec), Path(args.out)
-    outputs, report = build(spec_dir)
-    if vmod.failed(report, "timetables", spec_dir / SUB):
-        return 1
-    for name, obj in sorted(outputs.items()):
-        path = out_dir / f"{name}.json"
-        spec_mod.write_atomic(path, spec_mod.render_json(obj))
-        print(f"timetables: {name}: {len(obj['services'])} services on line {obj['line']} "
-              f"-> {path}")
-    return 0
+    return vmod.convert(SUB, args, build, _converted)
 
 
 def register(sub):

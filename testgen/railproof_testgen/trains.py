@@ -23,7 +23,6 @@ from __future__ import annotations
 from pathlib import Path
 
 from . import SPEC_DIR, add_command
-from . import spec as spec_mod
 from . import validate as vmod
 from .errors import SpecError
 
@@ -101,28 +100,23 @@ def check_trains(spec_dir, report, with_mutants=False):
 
 
 def build(spec_dir):
-    report = vmod.Report()
-    spec_dir = Path(spec_dir)
-    if not (spec_dir / SUB).is_dir():
-        report.error(spec_dir / SUB, "-", "train type directory not found")
-        return {}, report
-    outputs, refs = check_trains(spec_dir, report, with_mutants=True)
-    if not any(not m for m, _ in outputs) and not report.errors:
-        report.error(spec_dir / SUB, "-", "no train type files (*.yaml)")
-    vmod.check_assumption_refs(spec_dir, refs, report)
-    return outputs, report
+    return vmod.checked_directory(spec_dir, SUB, "train type",
+                                  lambda d, report: check_trains(d, report, with_mutants=True),
+                                  lambda outputs: any(not m for m, _ in outputs))
+
+
+def _converted(key, obj, path):
+    mutant, name = key
+    return f"{'negative-test ' if mutant else ''}{name} -> {path}"
+
+
+def _output_path(key):
+    mutant, name = key
+    return Path(MUTANTS if mutant else "") / f"{name}.json"
 
 
 def run(args):
-    spec_dir, out_dir = Path(args.spec), Path(args.out)
-    outputs, report = build(spec_dir)
-    if vmod.failed(report, "trains", spec_dir / SUB):
-        return 1
-    for (mutant, name), obj in sorted(outputs.items()):
-        path = out_dir / (MUTANTS if mutant else "") / f"{name}.json"
-        spec_mod.write_atomic(path, spec_mod.render_json(obj))
-        print(f"trains: {'negative-test ' if mutant else ''}{name} -> {path}")
-    return 0
+    return vmod.convert(SUB, args, build, _converted, _output_path)
 
 
 def register(sub):

@@ -287,15 +287,39 @@ def missing_data(spec_dir, sub, name, what):
     return f"unknown {what} {name!r} (no {sub}/{path.name})"
 
 
-def failed(report, command, where):
-    """Print the findings of a converting command; True (after a summary line) if there is
-    an error, and then the command writes nothing."""
+def checked_directory(spec_dir, sub, what, check, found):
+    """(outputs, report) of the data directory spec/<sub> (what: "line", "train type"): an
+    error if it is missing; else check(spec_dir, report) -> (outputs, refs), an error if
+    found(outputs) says it holds no file of its kind, and the assumption references."""
+    report = Report()
+    spec_dir = Path(spec_dir)
+    if not (spec_dir / sub).is_dir():
+        report.error(spec_dir / sub, "-", f"{what} directory not found")
+        return {}, report
+    outputs, refs = check(spec_dir, report)
+    if not found(outputs) and not report.errors:
+        report.error(spec_dir / sub, "-", f"no {what} files (*.yaml)")
+    check_assumption_refs(spec_dir, refs, report)
+    return outputs, report
+
+
+def convert(command, args, build, describe, path_of=lambda name: f"{name}.json"):
+    """Run a converting command (lines, trains, timetables: spec/<command> -> OUT): print the
+    findings of build(spec_dir) -> (outputs, report); on an error a summary line, nothing
+    written and exit status 1; else each output written as JSON to OUT/path_of(key), with
+    the line "<command>: describe(key, output, path)"."""
+    spec_dir, out_dir = Path(args.spec), Path(args.out)
+    outputs, report = build(spec_dir)
     report.print()
     if report.errors:
-        print(f"{command}: {len(report.errors)} error(s) in {where}; nothing written",
+        print(f"{command}: {len(report.errors)} error(s) in {spec_dir / command}; nothing written",
               file=sys.stderr)
-        return True
-    return False
+        return 1
+    for key, obj in sorted(outputs.items()):
+        path = out_dir / path_of(key)
+        spec_mod.write_atomic(path, spec_mod.render_json(obj))
+        print(f"{command}: {describe(key, obj, path)}")
+    return 0
 
 
 def raise_first(report):
