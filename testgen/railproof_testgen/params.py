@@ -16,15 +16,6 @@ def _cxx_literal(v):
     return repr(float(v))
 
 
-def _write_if_changed(path: Path, text: str):
-    path.parent.mkdir(parents=True, exist_ok=True)
-    if path.exists() and path.read_text(encoding="utf-8") == text:
-        return
-    tmp = path.with_suffix(path.suffix + ".tmp")
-    tmp.write_text(text, encoding="utf-8")
-    tmp.replace(path)  # atomic: never half-written
-
-
 def generate(spec_dir: Path, out_dir: Path):
     from .validate import validate_spec; validate_spec(spec_dir)  # noqa: E702
     areas = spec_mod.load_parameters(spec_dir)
@@ -54,9 +45,9 @@ def generate(spec_dir: Path, out_dir: Path):
             if ns:
                 lines.append(f"}}  // namespace {ns}")
         lines.append(f"}}  // namespace railproof::params::{name}")
-        _write_if_changed(Path(out_dir) / "include/railproof/generated" / f"{name}_params.hpp",
+        spec_mod.write_atomic(Path(out_dir) / "include/railproof/generated" / f"{name}_params.hpp",
                           "\n".join(lines) + "\n")
-        _write_if_changed(Path(out_dir) / "models" / f"{name}_params.pml", "\n".join(pml) + "\n")
+        spec_mod.write_atomic(Path(out_dir) / "models" / f"{name}_params.pml", "\n".join(pml) + "\n")
 
 
 def register(sub):

@@ -36,7 +36,7 @@ import jsonschema
 from . import SPEC_DIR, add_command
 from . import spin as spin_mod
 from .errors import SpecError
-from .spec import load_yaml
+from .spec import load_yaml, write_atomic
 
 REGISTRY = "capabilities.yaml"
 SCHEMA = "schemas/capabilities.schema.json"
@@ -347,16 +347,6 @@ def faults_header(reg: Registry) -> str:
     return "\n".join(lines) + "\n"
 
 
-def _write_if_changed(path: Path, text: str):
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    if path.exists() and path.read_text(encoding="utf-8") == text:
-        return
-    tmp = path.with_suffix(path.suffix + ".tmp")
-    tmp.write_text(text, encoding="utf-8")
-    tmp.replace(path)
-
-
 def run(args) -> int:
     reg = load(Path(args.spec))
     if args.check:
@@ -369,9 +359,9 @@ def run(args) -> int:
         print(f"registry: {len(reg.capabilities)} capabilities agree with the tree "
               f"({', '.join(c.name for c in reg.capabilities)})")
     if args.cmake:
-        _write_if_changed(Path(args.cmake), cmake_text(reg))
+        write_atomic(Path(args.cmake), cmake_text(reg))
     if args.faults_header:
-        _write_if_changed(Path(args.faults_header), faults_header(reg))
+        write_atomic(Path(args.faults_header), faults_header(reg))
     if args.json:
         data = {"schema": "railproof/registry/1", "capabilities": [
             {"name": c.name, "title": c.title, "sources": c.sources, "areas": c.areas,
@@ -380,7 +370,7 @@ def run(args) -> int:
              "conformance": c.conformance, "proofs": c.proofs, "studies": c.studies,
              "faults": [{"id": x.id, "text": x.text, "killed_by": x.killed_by} for x in c.faults]}
             for c in reg.capabilities]}
-        _write_if_changed(Path(args.json), json.dumps(data, indent=2, sort_keys=True) + "\n")
+        write_atomic(Path(args.json), json.dumps(data, indent=2, sort_keys=True) + "\n")
     return 0
 
 

@@ -62,6 +62,7 @@ from pathlib import Path
 from . import SPEC_DIR, add_command
 from . import registry as registry_mod
 from .errors import SpecError
+from .spec import write_atomic
 from .validate import REQ_ID, Report, check_spec
 
 SCHEMA = "railproof/trace/1"
@@ -986,12 +987,8 @@ def build_trace(spec_dir, src, results, allow_missing=False):
 
 
 def write_json(path, data):
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    text = json.dumps(data, indent=2, sort_keys=True, ensure_ascii=False) + "\n"
-    tmp = path.with_suffix(path.suffix + ".tmp")
-    tmp.write_text(text, encoding="utf-8")
-    tmp.replace(path)
+    write_atomic(path, json.dumps(data, indent=2, sort_keys=True, ensure_ascii=False) + "\n",
+                 if_changed=False)
 
 
 def run(args):

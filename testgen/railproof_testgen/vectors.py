@@ -47,7 +47,7 @@ from . import __version__, add_command
 from . import registry as registry_mod
 from . import spin as spin_mod
 from .errors import PipelineError, SpecError
-from .spec import load_yaml
+from .spec import load_yaml, write_atomic
 
 REACHED, UNREACHABLE = "reached", "unreachable"
 KINDS = ("trap", "boundary", "random")
@@ -266,17 +266,6 @@ def schema_checked_jsonl(schema_path: Path, lines, name: str) -> str:
     return "".join(json.dumps(o, sort_keys=True, separators=(",", ":")) + "\n" for o in lines)
 
 
-def atomic_write(path: Path, text: str):
-    """Write a file completely or not at all (a temporary file renamed over it)."""
-    path = Path(path)
-    tmp = path.with_name(path.name + ".tmp")
-    try:
-        tmp.write_text(text, encoding="utf-8")
-        tmp.replace(path)
-    finally:
-        tmp.unlink(missing_ok=True)
-
-
 # ---- the engine -------------------------------------------------------------------------------
 @dataclass
 class Outcome:
@@ -490,8 +479,9 @@ class Generation:
             if old.name not in texts:
                 old.unlink()  # a file of a configuration no longer generated
         for name, text in texts.items():
-            atomic_write(self.out_dir / name, text)
-        atomic_write(self.out_dir / f"{stem}.coverage.json", json.dumps(cov, indent=2, sort_keys=True) + "\n")
+            write_atomic(self.out_dir / name, text, if_changed=False)
+        write_atomic(self.out_dir / f"{stem}.coverage.json", json.dumps(cov, indent=2, sort_keys=True) + "\n",
+                     if_changed=False)
         _progress(f"goal coverage {reached}/{len(coverage)} reached, {cov['unreachable_justified']} unreachable "
                   f"justified; {len(all_vecs)} vectors written ("
                   + ", ".join(f"{n}: {k}" for n, k in cov["files"].items()) + ")")
