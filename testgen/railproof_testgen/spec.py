@@ -113,6 +113,20 @@ def render_json(obj):
     return json.dumps(obj, sort_keys=True, indent=1, ensure_ascii=False) + "\n"
 
 
+def jsonl_records(lines, malformed):
+    """(line number, object) of every non-blank line of a JSON Lines text; a malformed line is
+    handed to malformed(line number, json.JSONDecodeError) and skipped."""
+    for n, line in enumerate(lines, 1):
+        if not line.strip():
+            continue
+        try:
+            obj = json.loads(line)
+        except json.JSONDecodeError as exc:
+            malformed(n, exc)
+            continue
+        yield n, obj
+
+
 def write_atomic(path: Path, text: str, if_changed: bool = True):
     """Write text to path (and its directory), completely or not at all: a temporary file
     renamed over it, removed if that fails, so a reader never sees a half-written file. With
