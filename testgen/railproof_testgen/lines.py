@@ -161,6 +161,19 @@ class _Line:
             return None
         return a, b
 
+    def _range_on_track(self, entry, item, track, what, verb):
+        """The range of an item on a track (points, a platform) as _range, or None (reported,
+        or not judged while the track's own range is invalid): it must lie on the track."""
+        r = self._range(entry, item)
+        if r is None or track["range"] is None:
+            return None
+        lo, hi = track["range"]
+        if r[0] < lo or r[1] > hi:
+            self.err(entry, f"{what} {_sec(*r)} {verb} off the line (track {item['track']} "
+                            f"{_sec(lo, hi)})")
+            return None
+        return r
+
     # ---- coverage helpers
     def _cover(self, section, items, lo, hi, what):
         """Entries (entry, (a, b)) in order must tile [lo, hi) exactly.  An entry whose
@@ -453,13 +466,8 @@ class _Line:
                 self.err(entry, f"reverse_to: unknown track {p['reverse_to']!r}")
             elif p["reverse_to"] == p["track"]:
                 self.err(entry, f"reverse_to: leads to its own track {p['track']!r}")
-            r = self._range(entry, p)
-            if r is None or t["range"] is None:
-                continue
-            lo, hi = t["range"]
-            if r[0] < lo or r[1] > hi:
-                self.err(entry, f"points {_sec(*r)} are off the line (track {p['track']} "
-                                f"{_sec(lo, hi)})")
+            r = self._range_on_track(entry, p, t, "points", "are")
+            if r is None:
                 continue
             if p["track"] not in self.blocks:
                 continue  # the track's virtual blocks were rejected above
@@ -573,13 +581,8 @@ class _Line:
                 if t is None:
                     self.err(entry, f"unknown track {p['track']!r}")
                     continue
-                r = self._range(entry, p)
-                if r is None or t["range"] is None:
-                    continue
-                lo, hi = t["range"]
-                if r[0] < lo or r[1] > hi:
-                    self.err(entry, f"platform {_sec(*r)} is off the line (track {p['track']} "
-                                    f"{_sec(lo, hi)})")
+                r = self._range_on_track(entry, p, t, "platform", "is")
+                if r is None:
                     continue
                 if train_mm is not None and r[1] - r[0] < train_mm:
                     self.err(entry, f"platform of {_m(r[1] - r[0])} m is shorter than the "
