@@ -150,6 +150,21 @@ class Part(ABC):
         return sorted(vectors, key=lambda v: (v["kind"] == "random", v["kind"] == "trap", id_order(v["id"])))
 
 
+def model_lines(text: str, patterns: dict):
+    """(kind, match, line) of every @IN and @OUT line of a replay or walk (spin's output), kind
+    naming the first of patterns ({kind: regular expression}) that matches it; a line that none
+    matches is an error."""
+    for line in text.splitlines():
+        if "@IN" not in line and "@OUT" not in line:
+            continue
+        for kind, rx in patterns.items():
+            if m := rx.search(line):
+                yield kind, m, line
+                break
+        else:
+            raise PipelineError(f"unrecognised model output line: {line.strip()}")
+
+
 def id_order(vid: str):
     """Sort key of an id by its last number (G<k>, S<seed>), numerically."""
     m = re.search(r"(\d+)$", vid)

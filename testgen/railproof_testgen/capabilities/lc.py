@@ -30,7 +30,7 @@ from pathlib import Path
 
 from ..errors import PipelineError, SpecError
 from ..spin import model_text
-from ..vectors import Configuration, Part, model_bounds
+from ..vectors import Configuration, Part, model_bounds, model_lines
 
 TICK_MS = 10_000
 CELL_MM = 100_000
@@ -396,13 +396,7 @@ class LevelCrossing(Part):
         begins with its @IN tick line and is complete with @OUT move; a tick cut off by the end of
         a trail or walk is dropped."""
         ticks, cur = [], None
-        for line in text.splitlines():
-            if "@IN" not in line and "@OUT" not in line:
-                continue
-            kind = next((k for k, rx in _RX.items() if rx.search(line)), None)
-            if kind is None:
-                raise PipelineError(f"unrecognised model output line: {line.strip()}")
-            m = _RX[kind].search(line)
+        for kind, m, line in model_lines(text, _RX):
             g = [int(x) if x is not None else None for x in m.groups()]
             if kind == "tick":
                 cur = {"t": g[0], "x": g[1], "v": g[2], "ph": g[3], "dw": g[4], "ul": [], "other": None, "bar": {},
