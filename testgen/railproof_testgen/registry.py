@@ -46,6 +46,11 @@ SIDES = ("common", "onboard", "wayside")
 _FAULT_USE = re.compile(r"\bRAILPROOF_FAULT\((\w+)\)")
 
 
+def _named(template: str):
+    """A read-only property: the path template with the object's name filled in."""
+    return property(lambda self: template.format(name=self.name))
+
+
 @dataclass
 class Fault:
     id: str
@@ -58,9 +63,7 @@ class Model:
     name: str
     configurations: list
 
-    @property
-    def path(self) -> str:
-        return f"models/{self.name}.pml"
+    path = _named("models/{name}.pml")
 
 
 @dataclass
@@ -76,21 +79,10 @@ class Capability:
     faults: list = field(default_factory=list)
     studies: list = field(default_factory=list)
 
-    @property
-    def design(self) -> str:
-        return f"spec/design/{self.name}.md"
-
-    @property
-    def chapter(self) -> str:
-        return f"evidence/templates/{self.name}.rst.jinja"
-
-    @property
-    def vector_schema(self) -> str:
-        return f"spec/schemas/vectors_{self.name}.schema.json"
-
-    @property
-    def vector_part(self) -> str:
-        return f"testgen/railproof_testgen/capabilities/{self.name}.py"
+    design = _named("spec/design/{name}.md")
+    chapter = _named("evidence/templates/{name}.rst.jinja")
+    vector_schema = _named("spec/schemas/vectors_{name}.schema.json")
+    vector_part = _named("testgen/railproof_testgen/capabilities/{name}.py")
 
     def fault(self, fid: str) -> Fault | None:
         return next((f for f in self.faults if f.id == fid), None)
