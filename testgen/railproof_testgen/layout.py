@@ -28,6 +28,7 @@ import re
 import sys
 from pathlib import Path
 
+from . import add_command
 from .errors import PipelineError
 
 RUNTIME_EXTERNAL = {"PkgConfig::SODIUM"}
@@ -141,9 +142,7 @@ def run(args) -> int:
 
 
 def register(sub):
-    p = sub.add_parser("layout", help="check the module boundaries of the C++ tree (runtime/offline, "
-                                      "train/ground, includes)")
-    p.add_argument("--repo", required=True, help="repository root")
-    p.add_argument("--targets", required=True, help="build/gen/targets.json")
-    p.add_argument("--out", help="write the target graph and the findings here (JSON)")
-    p.set_defaults(func=run)
+    add_command(sub, "layout", run,
+                "check the module boundaries of the C++ tree (runtime/offline, train/ground, includes)",
+                repo="repository root", targets="build/gen/targets.json",
+                out={"help": "write the target graph and the findings here (JSON)"})

@@ -56,6 +56,7 @@ from __future__ import annotations
 from decimal import Decimal, InvalidOperation
 from pathlib import Path
 
+from . import SPEC_DIR, add_command
 from . import spec as spec_mod
 from . import validate as vmod
 from .errors import SpecError
@@ -159,6 +160,19 @@ class _Line:
                             f"{hi_key} {_m(b)} m")
             return None
         return a, b
+
+    def _range_on_track(self, entry, item, track, what, verb):
+        """The range of an item on a track (points, a platform) as _range, or None (reported,
+        or not judged while the track's own range is invalid): it must lie on the track."""
+        r = self._range(entry, item)
+        if r is None or track["range"] is None:
+            return None
+        lo, hi = track["range"]
+        if r[0] < lo or r[1] > hi:
+            self.err(entry, f"{what} {_sec(*r)} {verb} off the line (track {item['track']} "
+                            f"{_sec(lo, hi)})")
+            return None
+        return r
 
     # ---- coverage helpers
     def _cover(self, section, items, lo, hi, what):
@@ -452,13 +466,8 @@ class _Line:
                 self.err(entry, f"reverse_to: unknown track {p['reverse_to']!r}")
             elif p["reverse_to"] == p["track"]:
                 self.err(entry, f"reverse_to: leads to its own track {p['track']!r}")
-            r = self._range(entry, p)
-            if r is None or t["range"] is None:
-                continue
-            lo, hi = t["range"]
-            if r[0] < lo or r[1] > hi:
-                self.err(entry, f"points {_sec(*r)} are off the line (track {p['track']} "
-                                f"{_sec(lo, hi)})")
+            r = self._range_on_track(entry, p, t, "points", "are")
+            if r is None:
                 continue
             if p["track"] not in self.blocks:
                 continue  # the track's virtual blocks were rejected above
@@ -572,13 +581,8 @@ class _Line:
                 if t is None:
                     self.err(entry, f"unknown track {p['track']!r}")
                     continue
-                r = self._range(entry, p)
-                if r is None or t["range"] is None:
-                    continue
-                lo, hi = t["range"]
-                if r[0] < lo or r[1] > hi:
-                    self.err(entry, f"platform {_sec(*r)} is off the line (track {p['track']} "
-                                    f"{_sec(lo, hi)})")
+                r = self._range_on_track(entry, p, t, "platform", "is")
+                if r is None:
                     continue
                 if train_mm is not None and r[1] - r[0] < train_mm:
                     self.err(entry, f"platform of {_m(r[1] - r[0])} m is shorter than the "
@@ -850,16 +854,8 @@ def check_lines(spec_dir, report):
 
 def build(spec_dir):
     """(outputs, report) for spec_dir: all line files checked, references resolved."""
-    report = vmod.Report()
-    spec_dir = Path(spec_dir)
-    if not (spec_dir / SUB).is_dir():
-        report.error(spec_dir / SUB, "-", "line directory not found")
-        return {}, report
-    outputs, refs = check_lines(spec_dir, report)
-    if not line_files(spec_dir) and not report.errors:
-        report.error(spec_dir / SUB, "-", "no line files (*.yaml)")
-    vmod.check_assumption_refs(spec_dir, refs, report)
-    return outputs, report
+    return vmod.checked_directory(spec_dir, SUB, "line", check_lines,
+                                  lambda _outputs: line_files(spec_dir))
 
 
 def generate(spec_dir, out_dir):
@@ -872,29 +868,21 @@ def generate(spec_dir, out_dir):
     return sorted(outputs)
 
 
+def _converted(name, obj, path):
+    rls = obj["running_lines"]
+    return (f"{name}: {len(rls)} running line(s) ({', '.join(r['id'] for r in rls)}), "
+            f"{_m(rls[0]['length_mm'])} m, {sum(len(r['blocks_mm']) - 1 for r in rls)} virtual "
+            f"blocks -> {path}")
+
+
 def run(args):
-    spec_dir, out_dir = Path(args.spec), Path(args.out)
-    outputs, report = build(spec_dir)
-    if vmod.failed(report, "lines", spec_dir / SUB):
-        return 1
-    for name, obj in sorted(outputs.items()):
-        spec_mod.write_atomic(out_dir / f"{name}.json", spec_mod.render_json(obj))
-        rls = obj["running_lines"]
-        print(f"lines: {name}: {len(rls)} running line(s) "
-              f"({', '.join(r['id'] for r in rls)}), {_m(rls[0]['length_mm'])} m, "
-              f"{sum(len(r['blocks_mm']) - 1 for r in rls)} virtual blocks "
-              f"-> {out_dir / (name + '.json')}")
-    return 0
+    return vmod.convert(SUB, args, build, _converted)
 
 
 def register(sub):
-    p = sub.add_parser(
-        "lines", help="validate spec/lines and write the line JSON for the simulation",
-        description="Check every spec/lines/*.yaml against spec/schemas/line.schema.json and "
-                    "the topology rules of spec/lines/README.md, then write OUT/<name>.json "
-                    "(schema railproof/line-json/1). Prints every finding as "
-                    "'file: entry: reason'; on any error nothing is written and the exit "
-                    "status is 1.")
-    p.add_argument("--spec", required=True, help="spec/ directory")
-    p.add_argument("--out", required=True, help="output directory (build/gen/lines)")
-    p.set_defaults(func=run)
+    add_command(sub, "lines", run, "validate spec/lines and write the line JSON for the simulation",
+                """Check every spec/lines/*.yaml against spec/schemas/line.schema.json and the
+                topology rules of spec/lines/README.md, then write OUT/<name>.json (schema
+                railproof/line-json/1). Prints every finding as 'file: entry: reason'; on any
+                error nothing is written and the exit status is 1.""",
+                spec=SPEC_DIR, out="output directory (build/gen/lines)")

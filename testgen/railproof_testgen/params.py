@@ -4,6 +4,7 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
+from . import SPEC_DIR, add_command
 from . import spec as spec_mod
 
 _IDENT = re.compile(r"^[a-z][a-z0-9_]*$")
@@ -13,15 +14,6 @@ def _cxx_literal(v):
     if isinstance(v, int):
         return f"std::int64_t{{{v}}}"
     return repr(float(v))
-
-
-def _write_if_changed(path: Path, text: str):
-    path.parent.mkdir(parents=True, exist_ok=True)
-    if path.exists() and path.read_text(encoding="utf-8") == text:
-        return
-    tmp = path.with_suffix(path.suffix + ".tmp")
-    tmp.write_text(text, encoding="utf-8")
-    tmp.replace(path)  # atomic: never half-written
 
 
 def generate(spec_dir: Path, out_dir: Path):
@@ -53,13 +45,12 @@ def generate(spec_dir: Path, out_dir: Path):
             if ns:
                 lines.append(f"}}  // namespace {ns}")
         lines.append(f"}}  // namespace railproof::params::{name}")
-        _write_if_changed(Path(out_dir) / "include/railproof/generated" / f"{name}_params.hpp",
+        spec_mod.write_atomic(Path(out_dir) / "include/railproof/generated" / f"{name}_params.hpp",
                           "\n".join(lines) + "\n")
-        _write_if_changed(Path(out_dir) / "models" / f"{name}_params.pml", "\n".join(pml) + "\n")
+        spec_mod.write_atomic(Path(out_dir) / "models" / f"{name}_params.pml", "\n".join(pml) + "\n")
 
 
 def register(sub):
-    p = sub.add_parser("gen-params", help="validate spec/ and generate parameter headers")
-    p.add_argument("--spec", required=True, help="spec/ directory")
-    p.add_argument("--out", required=True, help="output directory (build/gen)")
-    p.set_defaults(func=lambda a: generate(Path(a.spec), Path(a.out)))
+    add_command(sub, "gen-params", lambda a: generate(Path(a.spec), Path(a.out)),
+                "validate spec/ and generate parameter headers",
+                spec=SPEC_DIR, out="output directory (build/gen)")

@@ -68,7 +68,9 @@ from dataclasses import dataclass, field
 from fractions import Fraction
 from pathlib import Path
 
+from . import SPEC_DIR, add_command
 from .errors import PipelineError, SpecError
+from .spec import write_atomic
 
 SCHEMA = "railproof/proofs/1"
 SOLVERS = ("z3", "cvc5")
@@ -602,7 +604,7 @@ def generate(spec_dir, proofs_dir, out_dir):
         for inst in insts:
             path = d / f"{inst.name}.smt2"
             wanted.add(path.name)
-            _write_if_changed(path, inst.smt2)
+            write_atomic(path, inst.smt2)
         hyp_dir = d / HYP_DIR
         if hyp_dir.is_dir():
             for old in hyp_dir.glob("*.smt2"):
@@ -610,7 +612,7 @@ def generate(spec_dir, proofs_dir, out_dir):
         for inst in insts:
             if inst.hyp is not None:
                 hyp_dir.mkdir(exist_ok=True)
-                _write_if_changed(hyp_dir / f"{inst.name}.smt2", inst.hyp)
+                write_atomic(hyp_dir / f"{inst.name}.smt2", inst.hyp)
         logs = {f"{Path(w).stem}.{s}.log" for w in wanted for s in SOLVERS}
         for stale in list(d.glob("*.smt2")) + list(d.glob("*.log")):
             if stale.name not in wanted and stale.name not in logs:
@@ -620,21 +622,6 @@ def generate(spec_dir, proofs_dir, out_dir):
         inputs[gen.rel(f)] = h
     inputs.update(gen.sources)
     return caps, dict(sorted(inputs.items()))
-
-
-def _write_if_changed(path: Path, text: str):
-    if path.exists() and path.read_text(encoding="utf-8") == text:
-        return
-    tmp = path.with_suffix(path.suffix + ".tmp")
-    tmp.write_text(text, encoding="utf-8")
-    tmp.replace(path)
-
-
-def _write_atomic(path: Path, text: str):
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_suffix(path.suffix + ".tmp")
-    tmp.write_text(text, encoding="utf-8")
-    tmp.replace(path)
 
 
 # --------------------------------------------------------------------- solving ----
@@ -876,8 +863,8 @@ def replay(caps, out_dir, timeout_s=DEFAULT_TIMEOUT_S, jobs=2, inputs=None, solv
         }
         if problems:
             data["problems"] = problems
-        _write_atomic(out_dir / f"{cap}.json",
-                      json.dumps(data, indent=2, sort_keys=True, ensure_ascii=False) + "\n")
+        write_atomic(out_dir / f"{cap}.json",
+                     json.dumps(data, indent=2, sort_keys=True, ensure_ascii=False) + "\n", if_changed=False)
         _write_logs(out_dir / cap, rows)
     return problems_all
 
@@ -905,8 +892,8 @@ def _witness(run, hyp_dir, inst, timeout_s):
             tried.append(f"{first} model not exact")
             continue
         wpath = hyp_dir / f"{inst.name}.witness.smt2"
-        _write_atomic(wpath, inst.hyp.rstrip("\n").rsplit("(check-sat)", 1)[0]
-                      + f"; the model of {first}\n" + fixed + "(check-sat)\n")
+        write_atomic(wpath, inst.hyp.rstrip("\n").rsplit("(check-sat)", 1)[0]
+                     + f"; the model of {first}\n" + fixed + "(check-sat)\n", if_changed=False)
         conf = run(second, wpath, timeout_s, opts.get(second, {}))
         t_total += conf.get("time_s") or 0.0
         tried.append(f"{second} on the model {conf['verdict']}")
@@ -979,7 +966,7 @@ def _write_logs(d: Path, rows):
                 lines.append(f"; solver time: {r['time_s']} s")
             for k, v in (r.get("model") or {}).items():
                 lines.append(f"; {k} = {v}")
-            _write_atomic(d / f"{row['name']}.{s}.log", "\n".join(lines) + "\n")
+            write_atomic(d / f"{row['name']}.{s}.log", "\n".join(lines) + "\n", if_changed=False)
 
 
 # --------------------------------------------------------------------- command ----
@@ -1005,21 +992,19 @@ def run(args):
 
 
 def register(sub):
-    p = sub.add_parser(
-        "proofs", help="generate the SMT proof obligations and replay them with z3 and cvc5",
-        description="Generate every obligation of PROOFS/<capability>/*.smt2.in from the "
-                    "spec parameters and train types into OUT/<capability>/, decide each with "
-                    "z3 and cvc5, and write OUT/<capability>.json. Exit 1 on a disagreement, "
-                    "an unexpected verdict, unknown or timeout, or bad input.")
-    p.add_argument("--spec", required=True, help="spec/ directory")
-    p.add_argument("--proofs", required=True, help="proofs/ directory (templates)")
-    p.add_argument("--out", required=True, help="output directory (build/results/proofs)")
-    p.add_argument("--timeout", type=float, default=DEFAULT_TIMEOUT_S,
-                   help=f"time limit per solver and obligation in s (default "
-                        f"{DEFAULT_TIMEOUT_S:g})")
-    p.add_argument("--jobs", type=int, default=2, help="solver processes in parallel "
-                                                       "(default 2)")
-    p.set_defaults(func=run)
+    add_command(sub, "proofs", run,
+                "generate the SMT proof obligations and replay them with z3 and cvc5",
+                """Generate every obligation of PROOFS/<capability>/*.smt2.in from the spec
+                parameters and train types into OUT/<capability>/, decide each with z3 and
+                cvc5, and write OUT/<capability>.json. Exit 1 on a disagreement, an unexpected
+                verdict, unknown or timeout, or bad input.""",
+                spec=SPEC_DIR, proofs="proofs/ directory (templates)",
+                out="output directory (build/results/proofs)",
+                timeout={"type": float, "default": DEFAULT_TIMEOUT_S,
+                         "help": f"time limit per solver and obligation in s (default "
+                                 f"{DEFAULT_TIMEOUT_S:g})"},
+                jobs={"type": int, "default": 2, "help": "solver processes in parallel (default 2)"})
+
 
 
 if __name__ == "__main__":

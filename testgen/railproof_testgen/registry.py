@@ -33,9 +33,10 @@ from pathlib import Path
 
 import jsonschema
 
+from . import SPEC_DIR, add_command
 from . import spin as spin_mod
 from .errors import SpecError
-from .spec import load_yaml
+from .spec import load_yaml, write_atomic
 
 REGISTRY = "capabilities.yaml"
 SCHEMA = "schemas/capabilities.schema.json"
@@ -43,6 +44,11 @@ SCHEMA = "schemas/capabilities.schema.json"
 SHARED = {"runtime": {"core", "messages", "units"}, "offline": {"common", "sim"}}
 SIDES = ("common", "onboard", "wayside")
 _FAULT_USE = re.compile(r"\bRAILPROOF_FAULT\((\w+)\)")
+
+
+def _named(template: str):
+    """A read-only property: the path template with the object's name filled in."""
+    return property(lambda self: template.format(name=self.name))
 
 
 @dataclass
@@ -57,9 +63,7 @@ class Model:
     name: str
     configurations: list
 
-    @property
-    def path(self) -> str:
-        return f"models/{self.name}.pml"
+    path = _named("models/{name}.pml")
 
 
 @dataclass
@@ -75,21 +79,10 @@ class Capability:
     faults: list = field(default_factory=list)
     studies: list = field(default_factory=list)
 
-    @property
-    def design(self) -> str:
-        return f"spec/design/{self.name}.md"
-
-    @property
-    def chapter(self) -> str:
-        return f"evidence/templates/{self.name}.rst.jinja"
-
-    @property
-    def vector_schema(self) -> str:
-        return f"spec/schemas/vectors_{self.name}.schema.json"
-
-    @property
-    def vector_part(self) -> str:
-        return f"testgen/railproof_testgen/capabilities/{self.name}.py"
+    design = _named("spec/design/{name}.md")
+    chapter = _named("evidence/templates/{name}.rst.jinja")
+    vector_schema = _named("spec/schemas/vectors_{name}.schema.json")
+    vector_part = _named("testgen/railproof_testgen/capabilities/{name}.py")
 
     def fault(self, fid: str) -> Fault | None:
         return next((f for f in self.faults if f.id == fid), None)
@@ -346,16 +339,6 @@ def faults_header(reg: Registry) -> str:
     return "\n".join(lines) + "\n"
 
 
-def _write_if_changed(path: Path, text: str):
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    if path.exists() and path.read_text(encoding="utf-8") == text:
-        return
-    tmp = path.with_suffix(path.suffix + ".tmp")
-    tmp.write_text(text, encoding="utf-8")
-    tmp.replace(path)
-
-
 def run(args) -> int:
     reg = load(Path(args.spec))
     if args.check:
@@ -368,9 +351,9 @@ def run(args) -> int:
         print(f"registry: {len(reg.capabilities)} capabilities agree with the tree "
               f"({', '.join(c.name for c in reg.capabilities)})")
     if args.cmake:
-        _write_if_changed(Path(args.cmake), cmake_text(reg))
+        write_atomic(Path(args.cmake), cmake_text(reg))
     if args.faults_header:
-        _write_if_changed(Path(args.faults_header), faults_header(reg))
+        write_atomic(Path(args.faults_header), faults_header(reg))
     if args.json:
         data = {"schema": "railproof/registry/1", "capabilities": [
             {"name": c.name, "title": c.title, "sources": c.sources, "areas": c.areas,
@@ -379,17 +362,15 @@ def run(args) -> int:
              "conformance": c.conformance, "proofs": c.proofs, "studies": c.studies,
              "faults": [{"id": x.id, "text": x.text, "killed_by": x.killed_by} for x in c.faults]}
             for c in reg.capabilities]}
-        _write_if_changed(Path(args.json), json.dumps(data, indent=2, sort_keys=True) + "\n")
+        write_atomic(Path(args.json), json.dumps(data, indent=2, sort_keys=True) + "\n")
     return 0
 
 
 def register(sub):
-    p = sub.add_parser("registry", help="check the capability registry against the tree and write "
-                                        "what the build reads from it")
-    p.add_argument("--spec", required=True, help="spec/ directory")
-    p.add_argument("--repo", default=".", help="repository root")
-    p.add_argument("--check", action="store_true", help="check the registry against the tree")
-    p.add_argument("--cmake", help="write the CMake variables here")
-    p.add_argument("--faults-header", help="write the seeded-fault identifiers (C++) here")
-    p.add_argument("--json", help="write the registry as JSON (for the evidence)")
-    p.set_defaults(func=run)
+    add_command(sub, "registry", run,
+                "check the capability registry against the tree and write what the build reads from it",
+                spec=SPEC_DIR, repo={"default": ".", "help": "repository root"},
+                check={"action": "store_true", "help": "check the registry against the tree"},
+                cmake={"help": "write the CMake variables here"},
+                faults_header={"help": "write the seeded-fault identifiers (C++) here"},
+                json={"help": "write the registry as JSON (for the evidence)"})

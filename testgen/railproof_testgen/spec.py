@@ -113,15 +113,34 @@ def render_json(obj):
     return json.dumps(obj, sort_keys=True, indent=1, ensure_ascii=False) + "\n"
 
 
-def write_atomic(path: Path, text: str):
-    """Write text to path unless it already holds it; a reader never sees a half-written file."""
+def jsonl_records(lines, malformed):
+    """(line number, object) of every non-blank line of a JSON Lines text; a malformed line is
+    handed to malformed(line number, json.JSONDecodeError) and skipped."""
+    for n, line in enumerate(lines, 1):
+        if not line.strip():
+            continue
+        try:
+            obj = json.loads(line)
+        except json.JSONDecodeError as exc:
+            malformed(n, exc)
+            continue
+        yield n, obj
+
+
+def write_atomic(path: Path, text: str, if_changed: bool = True):
+    """Write text to path (and its directory), completely or not at all: a temporary file
+    renamed over it, removed if that fails, so a reader never sees a half-written file. With
+    if_changed a file that already holds the text is left alone (its time stamp too)."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    if path.exists() and path.read_text(encoding="utf-8") == text:
+    if if_changed and path.exists() and path.read_text(encoding="utf-8") == text:
         return
     tmp = path.with_name(path.name + ".tmp")
-    tmp.write_text(text, encoding="utf-8")
-    tmp.replace(path)
+    try:
+        tmp.write_text(text, encoding="utf-8")
+        tmp.replace(path)
+    finally:
+        tmp.unlink(missing_ok=True)
 
 
 def spec_files(spec_dir: Path, sub: str):

@@ -35,16 +35,26 @@ from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from . import add_command
 from .errors import PipelineError, SpecError
 
-_REQ = re.compile(r"REQ-[A-Z]{2}-\d{3}")
-_PROP = re.compile(r"^\s*//\s*@property\s+(\w+)\s+((?:REQ-[A-Z]{2}-\d{3}\s*)+):\s*(.*)$")
-_GOAL = re.compile(r"^\s*//\s*@goal\s+(\d+)\s+((?:REQ-[A-Z]{2}-\d{3}\s*)+):\s*(.*)$")
-_MUT = re.compile(r"^\s*//\s*@mutant\s+(\w+)\s+violates\s+(\S+)\s*:\s*(.*)$")
-_ASSERT = re.compile(r"^\s*//\s*@assert\s+(\w+)\s+((?:REQ-[A-Z]{2}-\d{3}\s*)+):\s*(.*)$")
-_VARIANT = re.compile(r"^\s*//\s*@variant\s+(\w+)\s+(\w+)=(\w+)\s*:\s*(.*)$")
+_REQ_ID = r"REQ-[A-Z]{2}-\d{3}"
+_REQ = re.compile(_REQ_ID)
+_REQS = rf"((?:{_REQ_ID}\s*)+)"  # one or more requirement ids
+
+
+def _annotation(tag, fields):
+    """A `// @<tag> <fields>` line of a model (fields: the pattern after the tag)."""
+    return re.compile(rf"^\s*//\s*@{tag}\s+{fields}$")
+
+
+_PROP = _annotation("property", rf"(\w+)\s+{_REQS}:\s*(.*)")
+_GOAL = _annotation("goal", rf"(\d+)\s+{_REQS}:\s*(.*)")
+_MUT = _annotation("mutant", r"(\w+)\s+violates\s+(\S+)\s*:\s*(.*)")
+_ASSERT = _annotation("assert", rf"(\w+)\s+{_REQS}:\s*(.*)")
+_VARIANT = _annotation("variant", r"(\w+)\s+(\w+)=(\w+)\s*:\s*(.*)")
 _CONFIG = re.compile(r"\[config\s+(\w+(?:\s+\w+)*)\]")
-_PAN_FLAGS = re.compile(r"^\s*//\s*@pan_flags\s+((?:-D\w+(?:=\w+)?\s*)+)$")
+_PAN_FLAGS = _annotation("pan_flags", r"((?:-D\w+(?:=\w+)?\s*)+)")
 
 PAN_FLAGS = ["-O2", "-DSAFETY", "-DBFS", "-DMEMLIM=8000"]
 
@@ -632,13 +642,14 @@ def verify(model: Path, params_dir: Path, workdir: Path, out_json: Path, jobs: i
 
 
 def register(sub):
-    p = sub.add_parser("verify", help="model-check every named property and every mutant of a model")
-    p.add_argument("--model", required=True)
-    p.add_argument("--params", required=True, help="directory with the generated <model>_params.pml")
-    p.add_argument("--work", required=True, help="scratch directory (build tree)")
-    p.add_argument("--out", required=True, help="results JSON")
-    p.add_argument("--jobs", type=int, default=os.cpu_count() or 1)
-    p.set_defaults(func=lambda a: (verify(Path(a.model), Path(a.params), Path(a.work), Path(a.out), a.jobs), 0)[1])
+    add_command(sub, "verify",
+                lambda a: (verify(Path(a.model), Path(a.params), Path(a.work), Path(a.out), a.jobs), 0)[1],
+                "model-check every named property and every mutant of a model",
+                model={"required": True},
+                params="directory with the generated <model>_params.pml",
+                work="scratch directory (build tree)", out="results JSON",
+                jobs={"type": int, "default": os.cpu_count() or 1})
+
 
 
 if __name__ == "__main__":  # pragma: no cover

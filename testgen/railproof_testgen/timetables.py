@@ -31,6 +31,7 @@ import sys
 from decimal import Decimal
 from pathlib import Path
 
+from . import SPEC_DIR, add_command
 from . import spec as spec_mod
 from . import validate as vmod
 
@@ -279,29 +280,20 @@ def build(spec_dir):
     return outputs, report
 
 
+def _converted(name, obj, path):
+    return f"{name}: {len(obj['services'])} services on line {obj['line']} -> {path}"
+
+
 def run(args):
-    spec_dir, out_dir = Path(args.spec), Path(args.out)
-    outputs, report = build(spec_dir)
-    if vmod.failed(report, "timetables", spec_dir / SUB):
-        return 1
-    for name, obj in sorted(outputs.items()):
-        path = out_dir / f"{name}.json"
-        spec_mod.write_atomic(path, spec_mod.render_json(obj))
-        print(f"timetables: {name}: {len(obj['services'])} services on line {obj['line']} "
-              f"-> {path}")
-    return 0
+    return vmod.convert(SUB, args, build, _converted)
 
 
 def register(sub):
-    p = sub.add_parser(
-        "timetables", help="validate spec/timetables and write the timetable JSON",
-        description="Check every spec/timetables/*.yaml against "
-                    "spec/schemas/timetable.schema.json and the rules of "
-                    "spec/timetables/README.md (stations on the running line in running "
-                    "order, known train types, dwell times, platforms, departures in order), "
-                    "then write OUT/<name>.json (schema railproof/timetable-json/1, times in "
-                    "ms). Prints every finding as 'file: entry: reason'; on any error nothing "
-                    "is written and the exit status is 1.")
-    p.add_argument("--spec", required=True, help="spec/ directory")
-    p.add_argument("--out", required=True, help="output directory (build/gen/timetables)")
-    p.set_defaults(func=run)
+    add_command(sub, "timetables", run, "validate spec/timetables and write the timetable JSON",
+                """Check every spec/timetables/*.yaml against spec/schemas/timetable.schema.json
+                and the rules of spec/timetables/README.md (stations on the running line in
+                running order, known train types, dwell times, platforms, departures in
+                order), then write OUT/<name>.json (schema railproof/timetable-json/1, times in
+                ms). Prints every finding as 'file: entry: reason'; on any error nothing is
+                written and the exit status is 1.""",
+                spec=SPEC_DIR, out="output directory (build/gen/timetables)")

@@ -9,6 +9,8 @@ import subprocess
 from importlib import metadata
 from pathlib import Path
 
+from . import add_command
+
 DEBIAN_PACKAGES = ["spin", "cmake", "ninja-build", "g++", "clang", "libgtest-dev", "libbenchmark-dev",
                    "libsodium-dev", "coinor-libipopt-dev", "libompl-dev", "libbox2d-dev", "nlohmann-json3-dev",
                    "gcovr"]
@@ -55,14 +57,12 @@ def collect(compiler: str | None = None) -> dict:
 
 
 def register(sub):
-    p = sub.add_parser("toolversions", help="write the versions of the tool chain as JSON")
-    p.add_argument("--out", required=True)
-    p.add_argument("--compiler", default=None)
-
     def run(a):
         path = Path(a.out)
         path.parent.mkdir(parents=True, exist_ok=True)
         tmp = path.with_suffix(".tmp")
         tmp.write_text(json.dumps(collect(a.compiler), indent=2, sort_keys=True) + "\n", encoding="utf-8")
         tmp.replace(path)
-    p.set_defaults(func=run)
+
+    add_command(sub, "toolversions", run, "write the versions of the tool chain as JSON",
+                out={"required": True}, compiler={"default": None})

@@ -59,8 +59,10 @@ import re
 import sys
 from pathlib import Path
 
+from . import SPEC_DIR, add_command
 from . import registry as registry_mod
 from .errors import SpecError
+from .spec import jsonl_records, write_atomic
 from .validate import REQ_ID, Report, check_spec
 
 SCHEMA = "railproof/trace/1"
@@ -95,6 +97,14 @@ def _goal_id(k):
     """Goal ids: the model's numeric K and the coverage's "G<K>" name the same goal."""
     k = str(k).strip()
     return f"G{k}" if k.isdigit() else k
+
+
+def _tagged(lines, pattern):
+    """(line number, line, match) of every line that pattern matches."""
+    for n, line in enumerate(lines, 1):
+        m = pattern.search(line)
+        if m:
+            yield n, line, m
 
 
 class Tracer:
@@ -158,12 +168,7 @@ class Tracer:
             if not tok_clean.startswith("REQ-"):
                 break
             consumed += 1
-            if not REQ_ID.match(tok_clean):
-                self.error(file, entry, f"malformed requirement id {tok_clean!r}")
-            elif tok_clean not in self.model["requirements"]:
-                self.error(file, entry, f"dangling reference: unknown requirement {tok_clean}")
-            elif tok_clean not in ids:
-                ids.append(tok_clean)
+            self._collect_id(file, entry, tok_clean, ids)
         rest = " ".join(tokens[consumed:])
         return ids, rest, consumed
 
@@ -174,13 +179,18 @@ class Tracer:
             return []
         ids = []
         for r in lst:
-            if not REQ_ID.match(r):
-                self.error(file, entry, f"malformed requirement id {r!r}")
-            elif r not in self.model["requirements"]:
-                self.error(file, entry, f"dangling reference: unknown requirement {r}")
-            elif r not in ids:
-                ids.append(r)
+            self._collect_id(file, entry, r, ids)
         return ids
+
+    def _collect_id(self, file, entry, rid, ids):
+        """Append rid to ids (once) if it names a known requirement; an error if it is
+        malformed or unknown."""
+        if not REQ_ID.match(rid):
+            self.error(file, entry, f"malformed requirement id {rid!r}")
+        elif rid not in self.model["requirements"]:
+            self.error(file, entry, f"dangling reference: unknown requirement {rid}")
+        elif rid not in ids:
+            ids.append(rid)
 
     def add(self, rid, kind, item):
         lst = self.links[rid][kind]
@@ -193,6 +203,23 @@ class Tracer:
             return path.read_text(encoding="utf-8").splitlines()
         except UnicodeDecodeError:
             return None
+
+    def result_files(self, sub, pattern="*.json"):
+        """(RESULTS_DIR/sub, its files matching pattern, sorted; none if it is missing)."""
+        d = self.results / sub
+        return d, sorted(d.glob(pattern)) if d.is_dir() else []
+
+    def load_object(self, path, key):
+        """The JSON object of a results file that holds a list under key, or None (after an
+        error)."""
+        data = self.load_json(path)
+        if data is None:
+            return None
+        if not isinstance(data, dict) or not isinstance(data.get(key), list):
+            article = "an" if key[0] in "aeiou" else "a"
+            self.error(path, "-", f"expected an object with {article} '{key}' list")
+            return None
+        return data
 
     def load_json(self, path):
         try:
@@ -207,13 +234,7 @@ class Tracer:
     def scan_models(self):
         files = sorted((self.src / "models").rglob("*.pml"))
         for f in files:
-            lines = self.read_lines(f)
-            if lines is None:
-                continue
-            for n, line in enumerate(lines, 1):
-                m = _MODEL_TAG.search(line)
-                if not m:
-                    continue
+            for n, line, m in _tagged(self.read_lines(f) or [], _MODEL_TAG):
                 tag, body = m.group(1), m.group(2).strip()
                 body = re.sub(r"\*/\s*$", "", body).strip()
                 head, sep, text = body.partition(" : ")
@@ -291,28 +312,19 @@ class Tracer:
 
     # ------------------------------------------------------------- SPIN results ----
     def scan_spin(self):
-        d = self.results / "spin"
-        files = sorted(d.glob("*.json")) if d.is_dir() else []
+        d, files = self.result_files("spin")
         if not files:
             if self.properties or self.mutants or self._needs("model"):
                 self.missing_result(d, "model", "no model-checking results (spin/*.json)")
             return
         seen_mutants = set()
         for f in files:
-            data = self.load_json(f)
+            data = self.load_object(f, "properties")
             if data is None:
                 continue
-            if not isinstance(data, dict) or not isinstance(data.get("properties"), list):
-                self.error(f, "-", "expected an object with a 'properties' list")
-                continue
-            model_path = data.get("model")
-            if not isinstance(model_path, str):
-                self.error(f, "model", "missing model path")
+            model_path = self._model_ref(f, "model", data)
+            if model_path is None:
                 model_path = "?"
-            elif not (self.src / model_path).is_file():
-                self.error(f, "model", f"dangling reference: model {model_path} not found")
-            else:
-                self._check_hash(f, data.get("model_sha256"), model_path)
             for i, p in enumerate(data["properties"]):
                 self._spin_property(f, i, p, model_path)
             # named model assertions (// @assert): checked in every verification run
@@ -390,8 +402,7 @@ class Tracer:
 
     # ---------------------------------------------------------------- vectors ----
     def scan_vectors(self):
-        d = self.results / "vectors"
-        files = sorted(d.glob("*.jsonl")) if d.is_dir() else []
+        d, files = self.result_files("vectors", "*.jsonl")
         if not files:
             self.missing_result(d, "vectors", "no vector files (vectors/*.jsonl): "
                                               "empty or missing vector set")
@@ -415,21 +426,15 @@ class Tracer:
             return
         header = None
         count = 0
-        for n, line in enumerate(lines, 1):
-            if not line.strip():
-                continue
-            try:
-                obj = json.loads(line)
-            except json.JSONDecodeError as exc:
-                self.error(f, f"line {n}", f"malformed JSON: {exc.msg}")
-                continue
+        for n, obj in jsonl_records(lines, lambda n, exc: self.error(f, f"line {n}",
+                                                                     f"malformed JSON: {exc.msg}")):
             if header is None:
                 header = obj
                 if not isinstance(obj, dict) or obj.get("kind") != "header":
                     self.error(f, f"line {n}", "first line must be the header "
                                                "({\"kind\":\"header\",...})")
                 else:
-                    self._vector_header(f, obj)
+                    self._model_ref(f, "header", obj)
                 continue
             if not isinstance(obj, dict) or not isinstance(obj.get("id"), str):
                 self.error(f, f"line {n}", "vector needs an 'id'")
@@ -450,16 +455,18 @@ class Tracer:
             self.error(f, "-", "empty vector set (no vector after the header)")
         self.counts["vectors"] += count
 
-    def _vector_header(self, f, header):
-        model_path = header.get("model")
+    def _model_ref(self, f, entry, data):
+        """The model a results file (or a vector header) names, or None: an error if it names
+        none or one not in the source tree; a warning if it is of another model version."""
+        model_path = data.get("model")
         if not isinstance(model_path, str):
-            self.error(f, "header", "missing model path")
-            return
-        mf = self.src / model_path
-        if not mf.is_file():
-            self.error(f, "header", f"dangling reference: model {model_path} not found")
+            self.error(f, entry, "missing model path")
+            return None
+        if not (self.src / model_path).is_file():
+            self.error(f, entry, f"dangling reference: model {model_path} not found")
         else:
-            self._check_hash(f, header.get("model_sha256"), model_path)
+            self._check_hash(f, data.get("model_sha256"), model_path)
+        return model_path
 
     def _check_hash(self, f, sha, model_path):
         """Results from another version of the model are stale: warn (the hash is of the
@@ -472,11 +479,8 @@ class Tracer:
                                          "(results from another model version?)")
 
     def _coverage_file(self, f):
-        data = self.load_json(f)
+        data = self.load_object(f, "goals")
         if data is None:
-            return
-        if not isinstance(data, dict) or not isinstance(data.get("goals"), list):
-            self.error(f, "-", "expected an object with a 'goals' list")
             return
         model_path = data.get("model")
         if not isinstance(model_path, str):
@@ -573,10 +577,7 @@ class Tracer:
             lines = self.read_lines(f)
             if lines is None:
                 continue
-            for n, line in enumerate(lines, 1):
-                m = _CPP_TAG.search(line)
-                if not m:
-                    continue
+            for n, line, m in _tagged(lines, _CPP_TAG):
                 tag = m.group(1)
                 entry = f"@{tag} (line {n})"
                 ids, _rest, seen = self.parse_ids(f, entry, m.group(2))
@@ -725,17 +726,13 @@ class Tracer:
         self.scan_proof_results()
 
     def scan_proof_results(self):
-        d = self.results / "proofs"
-        files = sorted(d.glob("*.json")) if d.is_dir() else []
+        _d, files = self.result_files("proofs")
         if not files:
             return  # proof links come from the tags alone until the proofs have been replayed
         rows_by_name = {}
         for f in files:
-            data = self.load_json(f)
+            data = self.load_object(f, "obligations")
             if data is None:
-                continue
-            if not isinstance(data, dict) or not isinstance(data.get("obligations"), list):
-                self.error(f, "-", "expected an object with an 'obligations' list")
                 continue
             ids = self.check_req_list(f, "requirements", data.get("requirements"))
             if data.get("verdict") != "pass":
@@ -781,8 +778,7 @@ class Tracer:
 
     # --------------------------------------------------------------- analysis ----
     def scan_analysis(self):
-        d = self.results / "analysis"
-        files = sorted(d.glob("*.json")) if d.is_dir() else []
+        d, files = self.result_files("analysis")
         if not files:
             if self._needs("analysis"):
                 self.missing_result(d, "analysis", "no analysis results (analysis/*.json)")
@@ -985,12 +981,8 @@ def build_trace(spec_dir, src, results, allow_missing=False):
 
 
 def write_json(path, data):
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    text = json.dumps(data, indent=2, sort_keys=True, ensure_ascii=False) + "\n"
-    tmp = path.with_suffix(path.suffix + ".tmp")
-    tmp.write_text(text, encoding="utf-8")
-    tmp.replace(path)
+    write_atomic(path, json.dumps(data, indent=2, sort_keys=True, ensure_ascii=False) + "\n",
+                 if_changed=False)
 
 
 def run(args):
@@ -1015,17 +1007,12 @@ def run(args):
 
 
 def register(sub):
-    p = sub.add_parser(
-        "trace", help="check requirement traceability and write trace.json",
-        description="Link every requirement to model properties, vectors, code, tests, "
-                    "proofs and analysis results; fail on dangling references, violated "
-                    "properties, surviving mutants, unjustified unreachable goals and "
-                    "unverified requirements.")
-    p.add_argument("--spec", required=True, help="spec/ directory")
-    p.add_argument("--src", required=True, help="repository root (models/, cpp/, proofs/)")
-    p.add_argument("--results", required=True, help="results directory (spin/, vectors/, "
-                                                     "analysis/)")
-    p.add_argument("--out", required=True, help="trace.json to write")
-    p.add_argument("--allow-missing-results", action="store_true",
-                   help="missing results directories are warnings (before the pipeline ran)")
-    p.set_defaults(func=run)
+    add_command(sub, "trace", run, "check requirement traceability and write trace.json",
+                """Link every requirement to model properties, vectors, code, tests, proofs and
+                analysis results; fail on dangling references, violated properties, surviving
+                mutants, unjustified unreachable goals and unverified requirements.""",
+                spec=SPEC_DIR, src="repository root (models/, cpp/, proofs/)",
+                results="results directory (spin/, vectors/, analysis/)", out="trace.json to write",
+                allow_missing_results={"action": "store_true",
+                                       "help": "missing results directories are warnings (before "
+                                               "the pipeline ran)"})

@@ -22,7 +22,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from . import spec as spec_mod
+from . import SPEC_DIR, add_command
 from . import validate as vmod
 from .errors import SpecError
 
@@ -100,38 +100,30 @@ def check_trains(spec_dir, report, with_mutants=False):
 
 
 def build(spec_dir):
-    report = vmod.Report()
-    spec_dir = Path(spec_dir)
-    if not (spec_dir / SUB).is_dir():
-        report.error(spec_dir / SUB, "-", "train type directory not found")
-        return {}, report
-    outputs, refs = check_trains(spec_dir, report, with_mutants=True)
-    if not any(not m for m, _ in outputs) and not report.errors:
-        report.error(spec_dir / SUB, "-", "no train type files (*.yaml)")
-    vmod.check_assumption_refs(spec_dir, refs, report)
-    return outputs, report
+    return vmod.checked_directory(spec_dir, SUB, "train type",
+                                  lambda d, report: check_trains(d, report, with_mutants=True),
+                                  lambda outputs: any(not m for m, _ in outputs))
+
+
+def _converted(key, obj, path):
+    mutant, name = key
+    return f"{'negative-test ' if mutant else ''}{name} -> {path}"
+
+
+def _output_path(key):
+    mutant, name = key
+    return Path(MUTANTS if mutant else "") / f"{name}.json"
 
 
 def run(args):
-    spec_dir, out_dir = Path(args.spec), Path(args.out)
-    outputs, report = build(spec_dir)
-    if vmod.failed(report, "trains", spec_dir / SUB):
-        return 1
-    for (mutant, name), obj in sorted(outputs.items()):
-        path = out_dir / (MUTANTS if mutant else "") / f"{name}.json"
-        spec_mod.write_atomic(path, spec_mod.render_json(obj))
-        print(f"trains: {'negative-test ' if mutant else ''}{name} -> {path}")
-    return 0
+    return vmod.convert(SUB, args, build, _converted, _output_path)
 
 
 def register(sub):
-    p = sub.add_parser(
-        "trains", help="validate spec/trains and write the train JSON",
-        description="Check every spec/trains/*.yaml and spec/trains/mutants/*.yaml against "
-                    "spec/schemas/train.schema.json and the design rule REQ-BR-010 (not "
-                    "enforced for the negative-test types in mutants/), then write "
-                    "OUT/<name>.json and OUT/mutants/<name>.json (schema "
-                    "railproof/train-json/1). On any error nothing is written, exit 1.")
-    p.add_argument("--spec", required=True, help="spec/ directory")
-    p.add_argument("--out", required=True, help="output directory (build/gen/trains)")
-    p.set_defaults(func=run)
+    add_command(sub, "trains", run, "validate spec/trains and write the train JSON",
+                """Check every spec/trains/*.yaml and spec/trains/mutants/*.yaml against
+                spec/schemas/train.schema.json and the design rule REQ-BR-010 (not enforced
+                for the negative-test types in mutants/), then write OUT/<name>.json and
+                OUT/mutants/<name>.json (schema railproof/train-json/1). On any error nothing
+                is written, exit 1.""",
+                spec=SPEC_DIR, out="output directory (build/gen/trains)")

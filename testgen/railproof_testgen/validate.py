@@ -40,6 +40,7 @@ from pathlib import Path
 
 import jsonschema
 
+from . import SPEC_DIR, add_command
 from . import spec as spec_mod
 from .errors import SpecError
 
@@ -286,15 +287,39 @@ def missing_data(spec_dir, sub, name, what):
     return f"unknown {what} {name!r} (no {sub}/{path.name})"
 
 
-def failed(report, command, where):
-    """Print the findings of a converting command; True (after a summary line) if there is
-    an error, and then the command writes nothing."""
+def checked_directory(spec_dir, sub, what, check, found):
+    """(outputs, report) of the data directory spec/<sub> (what: "line", "train type"): an
+    error if it is missing; else check(spec_dir, report) -> (outputs, refs), an error if
+    found(outputs) says it holds no file of its kind, and the assumption references."""
+    report = Report()
+    spec_dir = Path(spec_dir)
+    if not (spec_dir / sub).is_dir():
+        report.error(spec_dir / sub, "-", f"{what} directory not found")
+        return {}, report
+    outputs, refs = check(spec_dir, report)
+    if not found(outputs) and not report.errors:
+        report.error(spec_dir / sub, "-", f"no {what} files (*.yaml)")
+    check_assumption_refs(spec_dir, refs, report)
+    return outputs, report
+
+
+def convert(command, args, build, describe, path_of=lambda name: f"{name}.json"):
+    """Run a converting command (lines, trains, timetables: spec/<command> -> OUT): print the
+    findings of build(spec_dir) -> (outputs, report); on an error a summary line, nothing
+    written and exit status 1; else each output written as JSON to OUT/path_of(key), with
+    the line "<command>: describe(key, output, path)"."""
+    spec_dir, out_dir = Path(args.spec), Path(args.out)
+    outputs, report = build(spec_dir)
     report.print()
     if report.errors:
-        print(f"{command}: {len(report.errors)} error(s) in {where}; nothing written",
+        print(f"{command}: {len(report.errors)} error(s) in {spec_dir / command}; nothing written",
               file=sys.stderr)
-        return True
-    return False
+        return 1
+    for key, obj in sorted(outputs.items()):
+        path = out_dir / path_of(key)
+        spec_mod.write_atomic(path, spec_mod.render_json(obj))
+        print(f"{command}: {describe(key, obj, path)}")
+    return 0
 
 
 def raise_first(report):
@@ -634,17 +659,15 @@ def run(args):
 
 
 def register(sub):
-    p = sub.add_parser(
-        "validate", help="check spec/ against its JSON schemas and cross-references",
-        description="Validate every file of spec/{requirements,hazards,assumptions,"
-                    "parameters,justifications,lines,trains,timetables} (YAML) and "
-                    "spec/{scenarios,wheelrail} (JSON) against spec/schemas and check IDs, "
-                    "references, the line topology rules and what each data file names in "
-                    "the others. Prints every finding as 'file: entry: reason'; exit 1 on "
-                    "any error.")
-    p.add_argument("--spec", required=True, help="spec/ directory")
-    p.add_argument("--data", action="append", default=[], metavar="FILE",
-                   help="also check this scenario or wheel-rail scenario JSON (for example "
-                        "one written by hand for line_sim or wheelrail_sim) against the "
-                        "spec; repeatable")
-    p.set_defaults(func=run)
+    add_command(sub, "validate", run, "check spec/ against its JSON schemas and cross-references",
+                """Validate every file of
+                spec/{requirements,hazards,assumptions,parameters,justifications,lines,trains,timetables}
+                (YAML) and spec/{scenarios,wheelrail} (JSON) against spec/schemas and check
+                IDs, references, the line topology rules and what each data file names in the
+                others. Prints every finding as 'file: entry: reason'; exit 1 on any
+                error.""",
+                spec=SPEC_DIR,
+                data={"action": "append", "default": [], "metavar": "FILE",
+                      "help": "also check this scenario or wheel-rail scenario JSON (for example one "
+                              "written by hand for line_sim or wheelrail_sim) against the spec; "
+                              "repeatable"})

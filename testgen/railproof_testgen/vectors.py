@@ -43,11 +43,11 @@ from pathlib import Path
 
 import jsonschema
 
-from . import __version__
+from . import __version__, add_command
 from . import registry as registry_mod
 from . import spin as spin_mod
 from .errors import PipelineError, SpecError
-from .spec import load_yaml
+from .spec import load_yaml, write_atomic
 
 REACHED, UNREACHABLE = "reached", "unreachable"
 KINDS = ("trap", "boundary", "random")
@@ -148,6 +148,21 @@ class Part(ABC):
         """The order of a file's vectors (define: the file's configuration): boundary, trap, then
         random vectors, each by goal or seed number."""
         return sorted(vectors, key=lambda v: (v["kind"] == "random", v["kind"] == "trap", id_order(v["id"])))
+
+
+def model_lines(text: str, patterns: dict):
+    """(kind, match, line) of every @IN and @OUT line of a replay or walk (spin's output), kind
+    naming the first of patterns ({kind: regular expression}) that matches it; a line that none
+    matches is an error."""
+    for line in text.splitlines():
+        if "@IN" not in line and "@OUT" not in line:
+            continue
+        for kind, rx in patterns.items():
+            if m := rx.search(line):
+                yield kind, m, line
+                break
+        else:
+            raise PipelineError(f"unrecognised model output line: {line.strip()}")
 
 
 def id_order(vid: str):
@@ -264,17 +279,6 @@ def schema_checked_jsonl(schema_path: Path, lines, name: str) -> str:
             raise PipelineError(f"generated {name} line {n} violates the vector schema: "
                                 f"{'/'.join(map(str, err.absolute_path)) or '(top level)'}: {message}")
     return "".join(json.dumps(o, sort_keys=True, separators=(",", ":")) + "\n" for o in lines)
-
-
-def atomic_write(path: Path, text: str):
-    """Write a file completely or not at all (a temporary file renamed over it)."""
-    path = Path(path)
-    tmp = path.with_name(path.name + ".tmp")
-    try:
-        tmp.write_text(text, encoding="utf-8")
-        tmp.replace(path)
-    finally:
-        tmp.unlink(missing_ok=True)
 
 
 # ---- the engine -------------------------------------------------------------------------------
@@ -490,8 +494,9 @@ class Generation:
             if old.name not in texts:
                 old.unlink()  # a file of a configuration no longer generated
         for name, text in texts.items():
-            atomic_write(self.out_dir / name, text)
-        atomic_write(self.out_dir / f"{stem}.coverage.json", json.dumps(cov, indent=2, sort_keys=True) + "\n")
+            write_atomic(self.out_dir / name, text, if_changed=False)
+        write_atomic(self.out_dir / f"{stem}.coverage.json", json.dumps(cov, indent=2, sort_keys=True) + "\n",
+                     if_changed=False)
         _progress(f"goal coverage {reached}/{len(coverage)} reached, {cov['unreachable_justified']} unreachable "
                   f"justified; {len(all_vecs)} vectors written ("
                   + ", ".join(f"{n}: {k}" for n, k in cov["files"].items()) + ")")
@@ -509,16 +514,17 @@ def generate(model: Path, params_dir: Path, spec_dir: Path, workdir: Path, out_d
 
 
 def register(sub):
-    p = sub.add_parser("vectors", help="derive conformance vectors (trap goals, boundaries, random walks)")
-    p.add_argument("--model", required=True)
-    p.add_argument("--params", required=True, help="directory with the generated <model>_params.pml")
-    p.add_argument("--spec", required=True, help="spec/ directory (registry, schemas, justifications)")
-    p.add_argument("--work", required=True)
-    p.add_argument("--out", required=True, help="output directory for <model>*.jsonl and <model>.coverage.json")
-    p.add_argument("--walks", type=int, default=50, help="random walks in the default configuration")
-    p.add_argument("--walk-steps", type=int, default=None,
-                   help="length of each random walk in SPIN statements, for models whose walks are bounded "
-                        "that way (default: the capability's)")
-    p.add_argument("--jobs", type=int, default=os.cpu_count() or 1)
-    p.set_defaults(func=lambda a: (generate(Path(a.model), Path(a.params), Path(a.spec), Path(a.work),
-                                            Path(a.out), a.walks, a.walk_steps, a.jobs), 0)[1])
+    add_command(sub, "vectors",
+                lambda a: (generate(Path(a.model), Path(a.params), Path(a.spec), Path(a.work),
+                                    Path(a.out), a.walks, a.walk_steps, a.jobs), 0)[1],
+                "derive conformance vectors (trap goals, boundaries, random walks)",
+                model={"required": True},
+                params="directory with the generated <model>_params.pml",
+                spec="spec/ directory (registry, schemas, justifications)",
+                work={"required": True},
+                out="output directory for <model>*.jsonl and <model>.coverage.json",
+                walks={"type": int, "default": 50, "help": "random walks in the default configuration"},
+                walk_steps={"type": int, "default": None,
+                            "help": "length of each random walk in SPIN statements, for models whose "
+                                    "walks are bounded that way (default: the capability's)"},
+                jobs={"type": int, "default": os.cpu_count() or 1})

@@ -2,8 +2,9 @@
 
 Fixture trees live in fixtures/spec_*: ``spec_valid`` is a complete miniature repository
 (spec/, models/, cpp/, proofs/, results/); every other ``spec_<case>`` directory holds
-only the files that differ from it (one broken thing each). ``tree(case)`` copies the
-valid tree, lays the case's files over it and adds the project's real JSON schemas, so
+only what differs from it (one broken thing each): files, and in ``edits.yaml`` the text
+edits of the valid tree's files ({file, old, new}: the first old text replaced). ``tree(case)``
+copies the valid tree, lays the case over it and adds the project's real JSON schemas, so
 the schemas under test are the ones in spec/schemas.
 """
 from __future__ import annotations
@@ -13,6 +14,7 @@ import sys
 from pathlib import Path
 
 import pytest
+import yaml
 
 TESTS = Path(__file__).resolve().parent
 REPO = TESTS.parents[1]
@@ -21,12 +23,22 @@ sys.path.insert(0, str(REPO / "testgen"))
 
 from railproof_testgen.__main__ import main  # noqa: E402
 
+EDITS = "edits.yaml"  # the text edits of an overlay
+
+
+def edit(path: Path, old: str, new: str):
+    """Replace the first occurrence of old (which must occur) in the text file path by new."""
+    text = path.read_text(encoding="utf-8")
+    assert old in text, f"{old!r} not in {path}"
+    path.write_text(text.replace(old, new, 1), encoding="utf-8")
+
 
 @pytest.fixture
 def tree(tmp_path):
-    """tree(*cases) -> Path of a fresh repository root built from spec_valid + overlays."""
+    """tree(*cases, edits=()) -> Path of a fresh repository root built from spec_valid +
+    overlays, with the text edits (file, old, new) applied last."""
 
-    def make(*cases):
+    def make(*cases, edits=()):
         root = tmp_path / "repo"
         if root.exists():
             shutil.rmtree(root)
@@ -34,12 +46,25 @@ def tree(tmp_path):
         for case in cases:
             overlay = FIXTURES / f"spec_{case}"
             assert overlay.is_dir(), f"no fixture {overlay}"
-            shutil.copytree(overlay, root, dirs_exist_ok=True)
+            shutil.copytree(overlay, root, dirs_exist_ok=True, ignore=shutil.ignore_patterns(EDITS))
+            if (overlay / EDITS).is_file():
+                for e in yaml.safe_load((overlay / EDITS).read_text(encoding="utf-8")):
+                    edit(root / e["file"], e["old"], e["new"])
         shutil.copytree(REPO / "spec" / "schemas", root / "spec" / "schemas",
                         dirs_exist_ok=True)
+        for file, old, new in edits:
+            edit(root / file, old, new)
         return root
 
     return make
+
+
+def fails_with(r, *findings):
+    """The run r failed (exit status 1) and names every finding (file suffix, entry, reason
+    fragment) in an error line."""
+    assert r.rc == 1, r.err
+    for finding in findings:
+        assert r.has(*finding), (finding, r.err)
 
 
 class CliResult:

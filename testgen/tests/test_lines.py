@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from conftest import FIXTURES, REPO
+from conftest import FIXTURES, REPO, fails_with
 from railproof_testgen import lines
 from railproof_testgen.errors import SpecError
 
@@ -473,14 +473,20 @@ def test_crossing_warning_time_below_the_minimum(line_spec, cli, tmp_path):
                     extra={"parameters/level_crossing.yaml": LC_PARAMS})
 
 
-# @verifies REQ-LC-016
-def test_crossing_warning_time_at_the_minimum_is_accepted(line_spec, cli, tmp_path):
-    spec = line_spec((LC1, "{id: LC1, at_m: 1500, width_m: 8, warning_time_s: 15}"),
-                     extra={"parameters/level_crossing.yaml": LC_PARAMS})
+def _warning_ms(line_spec, cli, tmp_path, crossing, running_line):
+    """The warning time in the line JSON of the crossing LC1, written as crossing, on the
+    running line of that index (with the level-crossing parameters LC_PARAMS)."""
+    spec = line_spec((LC1, crossing), extra={"parameters/level_crossing.yaml": LC_PARAMS})
     r = cli("lines", "--spec", spec, "--out", tmp_path / "out")
     assert r.rc == 0, r.err
     obj = json.loads((tmp_path / "out/mini_line.json").read_text())
-    assert obj["running_lines"][0]["level_crossings"][0]["warning_time_ms"] == 15_000
+    return obj["running_lines"][running_line]["level_crossings"][0]["warning_time_ms"]
+
+
+# @verifies REQ-LC-016
+def test_crossing_warning_time_at_the_minimum_is_accepted(line_spec, cli, tmp_path):
+    crossing = "{id: LC1, at_m: 1500, width_m: 8, warning_time_s: 15}"
+    assert _warning_ms(line_spec, cli, tmp_path, crossing, 0) == 15_000
 
 
 # @verifies REQ-LC-016
@@ -531,12 +537,7 @@ def test_crossing_width_rounded_outwards():
 
 
 def test_default_warning_time_from_the_parameters(line_spec, cli, tmp_path):
-    spec = line_spec((LC1, "{id: LC1, at_m: 1500, width_m: 8}"),
-                     extra={"parameters/level_crossing.yaml": LC_PARAMS})
-    r = cli("lines", "--spec", spec, "--out", tmp_path / "out")
-    assert r.rc == 0, r.err
-    obj = json.loads((tmp_path / "out/mini_line.json").read_text())
-    assert obj["running_lines"][1]["level_crossings"][0]["warning_time_ms"] == 30_000
+    assert _warning_ms(line_spec, cli, tmp_path, "{id: LC1, at_m: 1500, width_m: 8}", 1) == 30_000
 
 
 def test_crossing_without_warning_time_and_without_default(line_spec, cli, tmp_path):
@@ -584,11 +585,9 @@ def test_malformed_yaml(line_spec, cli, tmp_path):
 def test_all_errors_are_collected(line_spec, cli, tmp_path):
     spec = line_spec(CASES["balise_off_the_line"][:2], CASES["unknown_points_in_a_route"][:2],
                      CASES["handover_not_at_a_cell_boundary"][:2])
-    r = cli("lines", "--spec", spec, "--out", tmp_path / "out")
-    assert r.rc == 1
-    assert r.has(MINI, "balises[B2]", "off the line")
-    assert r.has(MINI, "routes[1]", "unknown points 'P9'")
-    assert r.has(MINI, "handovers[H1]", "not at a boundary")
+    fails_with(cli("lines", "--spec", spec, "--out", tmp_path / "out"),
+               (MINI, "balises[B2]", "off the line"), (MINI, "routes[1]", "unknown points 'P9'"),
+               (MINI, "handovers[H1]", "not at a boundary"))
 
 
 def test_nothing_written_if_any_line_is_invalid(line_spec, cli, tmp_path):

@@ -13,7 +13,7 @@ from pathlib import Path
 import pytest
 import yaml
 
-from conftest import REPO
+from conftest import REPO, edit
 from railproof_testgen import proofs
 from railproof_testgen.trace import build_trace
 
@@ -238,16 +238,11 @@ def test_contradictory_hypotheses_are_a_vacuous_proof(cli, tmp_path):
     assert row["meets_target"] is False and "unsatisfiable" in row["hypotheses"]["reason"]
 
 
-def _spec_copy(tmp_path):
-    d = tmp_path / "spec"
-    shutil.copytree(SPEC, d)
+def _copy(tmp_path, src):
+    """A copy of the directory src (SPEC or PROOFS) in tmp_path, of the same name."""
+    d = tmp_path / src.name
+    shutil.copytree(src, d)
     return d
-
-
-def _edit(path, old, new):
-    text = path.read_text()
-    assert old in text
-    path.write_text(text.replace(old, new, 1))
 
 
 @pytest.mark.parametrize("file,old,new,where,reason", [
@@ -261,19 +256,13 @@ def _edit(path, old, new):
 ])
 def test_bad_parameter_fails_with_file_entry_and_reason(cli, tmp_path, file, old, new, where,
                                                         reason):
-    spec = _spec_copy(tmp_path)
-    _edit(spec / file, old, new)
+    spec = _copy(tmp_path, SPEC)
+    edit(spec / file, old, new)
     res = cli("proofs", "--spec", spec, "--proofs", PROOFS, "--out", tmp_path / "out")
     assert res.rc == 1
     errors = [ln for ln in res.err.splitlines() if ln.startswith("railproof_testgen: error:")]
     assert len(errors) == 1 and where in errors[0] and reason in errors[0], res.err
     assert not (tmp_path / "out" / "br.json").exists()
-
-
-def _proofs_copy(tmp_path):
-    d = tmp_path / "proofs"
-    shutil.copytree(PROOFS, d)
-    return d
 
 
 @pytest.mark.parametrize("file,old,new,fragment", [
@@ -290,8 +279,8 @@ def _proofs_copy(tmp_path):
      "refers to V_MAX"),
 ])
 def test_template_errors_name_file_and_reason(cli, tmp_path, file, old, new, fragment):
-    pr = _proofs_copy(tmp_path)
-    _edit(pr / "br" / file, old, new)
+    pr = _copy(tmp_path, PROOFS)
+    edit(pr / "br" / file, old, new)
     res = cli("proofs", "--spec", SPEC, "--proofs", pr, "--out", tmp_path / "out")
     assert res.rc == 1
     assert "proofs/br/" in res.err and fragment in res.err, res.err
@@ -299,12 +288,12 @@ def test_template_errors_name_file_and_reason(cli, tmp_path, file, old, new, fra
 
 def test_a_lemma_changed_in_one_place_is_unproved(cli, tmp_path):
     """A user of a lemma whose definition differs from the proved one is refused."""
-    pr = _proofs_copy(tmp_path)
+    pr = _copy(tmp_path, PROOFS)
     lem = pr / "br" / "lemmas.smt2.in"
     text = lem.read_text()
     (pr / "br" / "lemmas_weak.smt2.in").write_text(
         text.replace("(<= db D)))", "(<= db (+ D 1.0))))"))
-    _edit(pr / "br" / "br_a_invariant.smt2.in", "{{include lemmas.smt2.in}}",
+    edit(pr / "br" / "br_a_invariant.smt2.in", "{{include lemmas.smt2.in}}",
           "{{include lemmas_weak.smt2.in}}")
     res = cli("proofs", "--spec", SPEC, "--proofs", pr, "--out", tmp_path / "out")
     assert res.rc == 1 and "uses lemma_braking but no obligation proves this definition" \

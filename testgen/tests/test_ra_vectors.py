@@ -4,8 +4,6 @@ conformance runner (railproof_conformance_ra) is the behavioural check of the ve
 tests check the parser, conversion, header and schema on hand-made model output, and that the
 vectors of a build (RAILPROOF_RESULTS_DIR) cover both machine configurations, follow design
 note §5 and hit the boundaries."""
-import copy
-import json
 from pathlib import Path
 
 import pytest
@@ -14,7 +12,7 @@ from railproof_testgen import spin, vectors
 from railproof_testgen.capabilities import ra
 from railproof_testgen.capabilities.ra import PART
 from railproof_testgen.errors import PipelineError
-from vector_results import vector_set
+from vector_results import check_schema_cases, vector_set
 
 REPO = Path(__file__).resolve().parents[2]
 MODEL = REPO / "models" / "ra.pml"
@@ -125,18 +123,9 @@ def test_header_records_the_machine_configuration():
 
 
 def test_schema_accepts_good_and_rejects_bad_records():
-    good = [_header(), _vector()]
-    text = vectors.schema_checked_jsonl(SCHEMA, good, "ra.jsonl")
-    assert [json.loads(ln) for ln in text.splitlines()] == good
     vectors.schema_checked_jsonl(SCHEMA, [_header("ONE_START"), {**_vector(), "id": "RA-TRAP-ONESTART-G0"}],
                                  "ra.one_start.jsonl")
-
-    def broken(edit):
-        lines = copy.deepcopy(good)
-        edit(lines)
-        return lines
-
-    cases = {
+    check_schema_cases(SCHEMA, [_header(), _vector()], "ra.jsonl", {
         "units": lambda ls: ls[0].update(units="cycles"),
         "configuration and start points disagree": lambda ls: ls[0]["parameters"].update(start_points=1),
         "unknown configuration": lambda ls: ls[0].update(configuration="THREE_START"),
@@ -152,11 +141,7 @@ def test_schema_accepts_good_and_rejects_bad_records():
         "three candidates": lambda ls: ls[1]["steps"][0]["out"]["candidates"].append(
             {"active": False, "age_cycles": 0, "confirm": 0}),
         "no steps": lambda ls: ls[1].update(steps=[]),
-    }
-    for what, edit in cases.items():
-        with pytest.raises(PipelineError, match="violates the vector schema"):
-            vectors.schema_checked_jsonl(SCHEMA, broken(edit), "ra.jsonl")
-            pytest.fail(f"schema accepted: {what}")
+    })
 
 
 def test_both_machine_configurations_have_their_file():

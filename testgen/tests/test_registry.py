@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from conftest import REPO
+from conftest import REPO, edit
 
 from railproof_testgen import registry
 
@@ -22,12 +22,6 @@ def repo(tmp_path):
         skip = shutil.ignore_patterns("corpus", "data", "bench") if part.startswith("cpp/") else None
         shutil.copytree(REPO / part, tmp_path / part, ignore=skip)
     return tmp_path
-
-
-def _edit(path: Path, old: str, new: str):
-    text = path.read_text(encoding="utf-8")
-    assert old in text, f"{old!r} not in {path}"
-    path.write_text(text.replace(old, new, 1), encoding="utf-8")
 
 
 def _check(cli, root):
@@ -82,7 +76,7 @@ def test_cmake_variables_and_fault_identifiers_come_from_the_registry(cli, tmp_p
 ])
 def test_every_disagreement_is_named(cli, repo, change, file, entry, fragment):
     rel, old, new = change
-    _edit(repo / rel, old, new)
+    edit(repo / rel, old, new)
     r = _check(cli, repo)
     assert r.rc == 1
     assert any(ln.startswith(f"{file}: {entry}: ") and fragment in ln for ln in r.lines), r.err
@@ -116,7 +110,7 @@ def test_missing_files_of_a_capability_are_named(cli, repo):
 
 
 def test_a_malformed_registry_names_the_entry(cli, repo):
-    _edit(repo / "spec/capabilities.yaml", "killed_by: [vectors, unit]}", "killed_by: [magic]}")
+    edit(repo / "spec/capabilities.yaml", "killed_by: [vectors, unit]}", "killed_by: [magic]}")
     r = _check(cli, repo)
     assert r.rc == 1
     assert "spec/capabilities.yaml: capabilities/0/faults/0/killed_by/0:" in r.err

@@ -5,17 +5,10 @@ from __future__ import annotations
 
 import json
 import shutil
-from pathlib import Path
 
 import pytest
 
-from conftest import REPO
-
-
-def _edit(path: Path, old: str, new: str):
-    text = path.read_text(encoding="utf-8")
-    assert old in text, f"{old!r} not in {path}"
-    path.write_text(text.replace(old, new, 1), encoding="utf-8")
+from conftest import REPO, edit, fails_with
 
 
 @pytest.fixture
@@ -190,31 +183,25 @@ def test_empty_vectors_leave_coverage_dangling(tree, trace):
      "analysis/residual_error.json", "verdict", "analysis result failed"),
 ])
 def test_dangling_and_inconsistent_links(tree, trace, file, old, new, efile, entry, fragment):
-    root = tree()
-    _edit(root / file, old, new)
-    r = trace(root)
-    assert r.rc == 1
-    assert r.has(efile, entry, fragment), r.err
+    fails_with(trace(tree(edits=[(file, old, new)])), (efile, entry, fragment))
 
 
-@pytest.mark.parametrize("file, old, new, spec_file, rid, fragment", [
+@pytest.mark.parametrize("file, old, new, rid, fragment", [
     ("results/analysis/residual_error.json", '"REQ-TG-002", "REQ-TG-004"', '"REQ-TG-002"',
-     "tg.yaml", "REQ-TG-004", "verification 'analysis': no analysis result names it"),
-    ("proofs/mb/stop_limit.smt2", "; @obligation", "; obligation",
-     "mb.yaml", "REQ-MB-001", "verification 'proof': no proof obligation names it"),
+     "REQ-TG-004", "verification 'analysis': no analysis result names it"),
+    ("proofs/mb/stop_limit.smt2", "; @obligation", "; obligation", "REQ-MB-001",
+     "verification 'proof': no proof obligation names it"),
 ])
-def test_missing_link_kind(tree, trace, file, old, new, spec_file, rid, fragment):
-    root = tree()
-    _edit(root / file, old, new)
-    r = trace(root)
-    assert r.rc == 1
-    assert r.has(f"spec/requirements/{spec_file}", rid, fragment), r.err
+def test_missing_link_kind(tree, trace, file, old, new, rid, fragment):
+    """The requirement rid (in spec/requirements/<its area>.yaml) lacks a kind of link."""
+    r = trace(tree(edits=[(file, old, new)]))
+    fails_with(r, (f"spec/requirements/{rid[4:6].lower()}.yaml", rid, fragment))
     assert _req(r, rid)["status"] == "error"
 
 
 def test_extra_links_never_hurt(tree, trace):
     root = tree()
-    _edit(root / "results/vectors/demo.jsonl", '["REQ-TG-001"], "goal": null',
+    edit(root / "results/vectors/demo.jsonl", '["REQ-TG-001"], "goal": null',
           '["REQ-TG-001", "REQ-TG-003"], "goal": null')
     r = trace(root)
     assert r.rc == 0, r.err
@@ -274,9 +261,9 @@ def test_flag_does_not_hide_source_problems_or_bad_results(tree, trace):
 def test_flag_still_requires_a_property_annotation(tree, trace):
     root = tree()
     shutil.rmtree(root / "results")
-    _edit(root / "models/demo.pml",
+    edit(root / "models/demo.pml",
           "// @property REQ_TG_001_repetition REQ-TG-001 : no telegram is accepted twice\n", "")
-    _edit(root / "models/demo.pml", "violates REQ_TG_001_repetition", "violates gone")
+    edit(root / "models/demo.pml", "violates REQ_TG_001_repetition", "violates gone")
     r = trace(root, "--allow-missing-results")
     assert r.rc == 1
     assert r.has("spec/requirements/tg.yaml", "REQ-TG-001",
@@ -300,7 +287,7 @@ def test_tags_in_prose_and_doc_examples_are_not_links(tree, trace):
 
 def test_disabled_test_does_not_count(tree, trace):
     root = tree()
-    _edit(root / "cpp/runtime/demo/tests/demo_test.cpp", "TEST(Sequence, RejectsRepetition)",
+    edit(root / "cpp/runtime/demo/tests/demo_test.cpp", "TEST(Sequence, RejectsRepetition)",
           "TEST(Sequence, DISABLED_RejectsRepetition)")
     r = trace(root)
     assert r.rc == 1
@@ -378,7 +365,7 @@ def test_offline_requirement_needs_an_offline_tool(tree, trace):
     """implemented_by: offline exempts a requirement from runtime code only if an offline tool
     implements it; runtime code does not count for it either."""
     root = tree()
-    _edit(root / "spec/requirements/tg.yaml", "id: REQ-TG-002\n", "id: REQ-TG-002\n    implemented_by: offline\n")
+    edit(root / "spec/requirements/tg.yaml", "id: REQ-TG-002\n", "id: REQ-TG-002\n    implemented_by: offline\n")
     r = trace(root)
     assert r.rc == 1
     assert r.has("spec/requirements/tg.yaml", "REQ-TG-002",
@@ -398,8 +385,8 @@ def test_every_requirement_belongs_to_a_registered_capability(tree, trace):
     assert r.rc == 0, r.err
     data = json.loads((root / "out" / "trace.json").read_text(encoding="utf-8"))
     assert {x["id"]: x["capability"] for x in data["requirements"]}["REQ-MB-001"] == "mb"
-    _edit(root / "spec/capabilities.yaml", "    areas: [MB]\n", "    areas: [BR]\n")
-    _edit(root / "spec/capabilities.yaml", "  - name: mb\n", "  - name: br\n")
+    edit(root / "spec/capabilities.yaml", "    areas: [MB]\n", "    areas: [BR]\n")
+    edit(root / "spec/capabilities.yaml", "  - name: mb\n", "  - name: br\n")
     r = trace(root)
     assert r.rc == 1
     assert r.has("spec/requirements/mb.yaml", "REQ-MB-001", "area MB belongs to no capability of")

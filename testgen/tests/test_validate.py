@@ -3,20 +3,19 @@
 from __future__ import annotations
 
 import json
-from pathlib import Path
 
 import jsonschema
 import pytest
 
-from conftest import REPO
+from conftest import REPO, fails_with
 from railproof_testgen import params, validate
 from railproof_testgen.errors import SpecError
 
 
-def _edit(path: Path, old: str, new: str):
-    text = path.read_text(encoding="utf-8")
-    assert old in text, f"{old!r} not in {path}"
-    path.write_text(text.replace(old, new, 1), encoding="utf-8")
+@pytest.fixture
+def validate_cmd(cli):
+    """validate_cmd(root) runs the validate command on the spec/ of a fixture repository."""
+    return lambda root: cli("validate", "--spec", root / "spec")
 
 
 def test_schemas_are_valid_draft_2020_12():
@@ -34,9 +33,9 @@ def test_real_spec_passes(cli):
     assert "ok" in r.out
 
 
-def test_valid_fixture_passes_and_returns_model(tree, cli):
+def test_valid_fixture_passes_and_returns_model(tree, validate_cmd):
     root = tree()
-    r = cli("validate", "--spec", root / "spec")
+    r = validate_cmd(root)
     assert r.rc == 0, r.err
     model = validate.validate_spec(root / "spec")
     assert sorted(model["requirements"]) == ["REQ-MB-001", "REQ-TG-001", "REQ-TG-002",
@@ -66,28 +65,20 @@ def test_valid_fixture_passes_and_returns_model(tree, cli):
     ("review_only_sil4", "requirements/tg.yaml", "REQ-TG-003",
      "verified by review alone"),
 ])
-def test_spec_error_classes(tree, cli, case, file, entry, fragment):
-    root = tree(case)
-    r = cli("validate", "--spec", root / "spec")
-    assert r.rc == 1
-    assert r.has(file, entry, fragment), r.err
+def test_spec_error_classes(tree, validate_cmd, case, file, entry, fragment):
+    fails_with(validate_cmd(tree(case)), (file, entry, fragment))
 
 
-def test_duplicate_id_names_both_files(tree, cli):
-    root = tree("duplicate_id")
-    r = cli("validate", "--spec", root / "spec")
+def test_duplicate_id_names_both_files(tree, validate_cmd):
+    r = validate_cmd(tree("duplicate_id"))
     line = next(ln for ln in r.lines if "duplicate id" in ln)
     assert "tg_extra.yaml: REQ-TG-001:" in line
     assert "requirements/tg.yaml)" in line
 
 
-def test_duplicate_id_within_one_file(tree, cli):
-    root = tree()
-    f = root / "spec/hazards/hazards.yaml"
-    _edit(f, "id: HAZ-002", "id: HAZ-001")
-    r = cli("validate", "--spec", root / "spec")
-    assert r.rc == 1
-    assert r.has("hazards/hazards.yaml", "HAZ-001", "duplicate id")
+def test_duplicate_id_within_one_file(tree, validate_cmd):
+    root = tree(edits=[("spec/hazards/hazards.yaml", "id: HAZ-002", "id: HAZ-001")])
+    fails_with(validate_cmd(root), ("hazards/hazards.yaml", "HAZ-001", "duplicate id"))
 
 
 @pytest.mark.parametrize("old, new, file, entry, fragment", [
@@ -117,21 +108,14 @@ def test_duplicate_id_within_one_file(tree, cli):
     ("    hazards: []\n", "    hazard: []\n", "requirements/tg.yaml", "REQ-TG-003",
      "'hazard' was unexpected"),
 ])
-def test_requirement_rules(tree, cli, old, new, file, entry, fragment):
-    root = tree()
-    _edit(root / "spec" / file, old, new)
-    r = cli("validate", "--spec", root / "spec")
-    assert r.rc == 1
-    assert r.has(file, entry, fragment), r.err
+def test_requirement_rules(tree, validate_cmd, old, new, file, entry, fragment):
+    fails_with(validate_cmd(tree(edits=[(f"spec/{file}", old, new)])), (file, entry, fragment))
 
 
-def test_unaddressed_hazard_is_an_error(tree, cli):
-    root = tree()
-    _edit(root / "spec/requirements/mb.yaml", "hazards: [HAZ-003]",
-          "hazards: [HAZ-001]")
-    r = cli("validate", "--spec", root / "spec")
-    assert r.rc == 1
-    assert r.has("hazards/hazards.yaml", "HAZ-003", "not addressed by any requirement")
+def test_unaddressed_hazard_is_an_error(tree, validate_cmd):
+    root = tree(edits=[("spec/requirements/mb.yaml", "hazards: [HAZ-003]", "hazards: [HAZ-001]")])
+    fails_with(validate_cmd(root),
+               ("hazards/hazards.yaml", "HAZ-003", "not addressed by any requirement"))
 
 
 @pytest.mark.parametrize("old, new, entry, fragment", [
@@ -148,61 +132,48 @@ def test_unaddressed_hazard_is_an_error(tree, cli):
      "rationale: reduced width for the model (ASM-003)", "model_seq_modulus",
      "rationale: unknown assumption ASM-003"),
 ])
-def test_parameter_rules(tree, cli, old, new, entry, fragment):
-    root = tree()
-    _edit(root / "spec/parameters/tg.yaml", old, new)
-    r = cli("validate", "--spec", root / "spec")
-    assert r.rc == 1
-    assert r.has("parameters/tg.yaml", entry, fragment), r.err
+def test_parameter_rules(tree, validate_cmd, old, new, entry, fragment):
+    fails_with(validate_cmd(tree(edits=[("spec/parameters/tg.yaml", old, new)])),
+               ("parameters/tg.yaml", entry, fragment))
 
 
-def test_two_parameter_files_for_one_area(tree, cli):
+def test_two_parameter_files_for_one_area(tree, validate_cmd):
     root = tree()
     src = root / "spec/parameters/tg.yaml"
     (root / "spec/parameters/tg2.yaml").write_text(src.read_text(encoding="utf-8"),
                                                          encoding="utf-8")
-    r = cli("validate", "--spec", root / "spec")
-    assert r.rc == 1
-    assert r.has("parameters/tg2.yaml", "area", "also declared by")
+    fails_with(validate_cmd(root), ("parameters/tg2.yaml", "area", "also declared by"))
 
 
-def test_justification_rules(tree, cli):
-    root = tree()
-    _edit(root / "spec/justifications/tg.yaml", "id: UR-TG-001", "id: UR-XX-001")
-    r = cli("validate", "--spec", root / "spec")
-    assert r.rc == 1
-    assert r.has("justifications/tg.yaml", "UR-XX-001", "does not match")
+def test_justification_rules(tree, validate_cmd):
+    root = tree(edits=[("spec/justifications/tg.yaml", "id: UR-TG-001", "id: UR-XX-001")])
+    fails_with(validate_cmd(root), ("justifications/tg.yaml", "UR-XX-001", "does not match"))
 
 
-def test_yml_extension_is_not_silently_ignored(tree, cli):
+def test_yml_extension_is_not_silently_ignored(tree, validate_cmd):
     root = tree()
     (root / "spec/hazards/more.yml").write_text("schema: railproof/hazards/1\n",
                                                 encoding="utf-8")
-    r = cli("validate", "--spec", root / "spec")
-    assert r.rc == 1
-    assert r.has("hazards/more.yml", "-", "use the .yaml extension")
+    fails_with(validate_cmd(root), ("hazards/more.yml", "-", "use the .yaml extension"))
 
 
-def test_unreferenced_assumption_is_a_warning(tree, cli):
-    root = tree()
-    _edit(root / "spec/parameters/tg.yaml", "source: ASM-001", "source: D5 §6.3")
-    _edit(root / "spec/requirements/tg.yaml", "[EN 50159 §7.3, ASM-001]",
-          "[EN 50159 §7.3]")
-    r = cli("validate", "--spec", root / "spec")
+def test_unreferenced_assumption_is_a_warning(tree, validate_cmd):
+    root = tree(edits=[("spec/parameters/tg.yaml", "source: ASM-001", "source: D5 §6.3"),
+                       ("spec/requirements/tg.yaml", "[EN 50159 §7.3, ASM-001]",
+                        "[EN 50159 §7.3]")])
+    r = validate_cmd(root)
     assert r.rc == 0, r.err
     assert r.warned("assumptions/assumptions.yaml", "ASM-001", "not referenced")
 
 
-def test_all_errors_are_collected_across_files(tree, cli):
-    root = tree("malformed_yaml", "unknown_asm", "bad_id", "duplicate_key")
-    r = cli("validate", "--spec", root / "spec")
-    assert r.rc == 1
-    assert r.has("hazards/hazards.yaml", "line 5", "malformed YAML")
-    assert r.has("assumptions/assumptions.yaml", "line 9", "duplicate key")
-    assert r.has("requirements/mb.yaml", "REQ-MB-001", "unknown assumption ASM-042")
-    assert r.has("requirements/tg.yaml", "REQ-TG-03", "does not match")
-    # the unreadable hazards file leaves every hazard reference dangling: reported too
-    assert r.has("requirements/tg.yaml", "REQ-TG-001", "unknown hazard HAZ-001")
+def test_all_errors_are_collected_across_files(tree, validate_cmd):
+    r = validate_cmd(tree("malformed_yaml", "unknown_asm", "bad_id", "duplicate_key"))
+    fails_with(r, ("hazards/hazards.yaml", "line 5", "malformed YAML"),
+               ("assumptions/assumptions.yaml", "line 9", "duplicate key"),
+               ("requirements/mb.yaml", "REQ-MB-001", "unknown assumption ASM-042"),
+               ("requirements/tg.yaml", "REQ-TG-03", "does not match"),
+               # the unreadable hazards file leaves every hazard reference dangling: reported too
+               ("requirements/tg.yaml", "REQ-TG-001", "unknown hazard HAZ-001"))
     assert len(r.lines) >= 6
     assert r.lines[-1].startswith("validate: ")
 
@@ -237,9 +208,7 @@ def test_gen_params_on_valid_spec(tree, tmp_path, cli):
     assert "inline constexpr auto crc16_poly = std::int64_t{4129};" in hdr
 
 
-def test_missing_schema_is_reported(tree, cli):
+def test_missing_schema_is_reported(tree, validate_cmd):
     root = tree()
     (root / "spec/schemas/hazards.schema.json").unlink()
-    r = cli("validate", "--spec", root / "spec")
-    assert r.rc == 1
-    assert r.has("schemas/hazards.schema.json", "-", "schema file not found")
+    fails_with(validate_cmd(root), ("schemas/hazards.schema.json", "-", "schema file not found"))

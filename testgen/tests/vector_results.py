@@ -1,8 +1,10 @@
 """The vector sets of a build, for the tests that check them. Those tests read the pipeline's
 results and never regenerate the vectors: the environment variable RAILPROOF_RESULTS_DIR names
-a build's results directory (ctest sets it); without it they are skipped."""
+a build's results directory (ctest sets it); without it they are skipped. Also the check of a
+capability's vector schema on hand-made records (check_schema_cases)."""
 from __future__ import annotations
 
+import copy
 import json
 import os
 from pathlib import Path
@@ -11,7 +13,8 @@ import jsonschema
 import pytest
 import yaml
 
-from railproof_testgen import registry, spin
+from railproof_testgen import registry, spin, vectors
+from railproof_testgen.errors import PipelineError
 
 REPO = Path(__file__).resolve().parents[2]
 RESULTS_VAR = "RAILPROOF_RESULTS_DIR"
@@ -106,3 +109,21 @@ def check_vector_set(vs: VectorSet):
         for tag in {v["id"].rsplit("S", 1)[0] for v in vs.vectors(name) if v["kind"] == "random"}:
             seeds = sorted({v["seed"] for v in vs.vectors(name) if v["id"].rsplit("S", 1)[0] == tag})
             assert seeds == list(range(1, len(seeds) + 1)), (name, tag)
+
+
+def edited(records: list, edit) -> list:
+    """A deep copy of records (the lines of a vector file) with edit applied to it."""
+    lines = copy.deepcopy(records)
+    edit(lines)
+    return lines
+
+
+def check_schema_cases(schema: Path, good: list, name: str, broken: dict):
+    """The records good (a header and vectors) pass the vector schema unchanged as the file
+    name; each edit of broken ({what: edit of a copy of good}) makes them fail it."""
+    text = vectors.schema_checked_jsonl(schema, good, name)
+    assert [json.loads(ln) for ln in text.splitlines()] == good
+    for what, edit in broken.items():
+        with pytest.raises(PipelineError, match="violates the vector schema"):
+            vectors.schema_checked_jsonl(schema, edited(good, edit), name)
+            pytest.fail(f"schema accepted: {what}")

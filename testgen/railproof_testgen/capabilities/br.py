@@ -13,7 +13,7 @@ from __future__ import annotations
 import re
 
 from ..errors import PipelineError
-from ..vectors import Configuration, Part, model_bounds
+from ..vectors import Configuration, Part, model_bounds, model_lines
 
 # br::BrakeLevel in order, named as br::ToString
 LEVELS = ["NONE", "4N", "5N", "6N", "7N", "EB"]
@@ -24,9 +24,11 @@ UNITS = "abstract speed units = mm/s"
 LEVEL_REQS = {"NONE": ["REQ-BR-003"], "4N": ["REQ-BR-003"], "5N": ["REQ-BR-003"], "6N": ["REQ-BR-003"],
               "7N": ["REQ-BR-002"], "EB": ["REQ-BR-001", "REQ-BR-006"]}
 
-_RX_CYCLE = re.compile(r"@IN cycle vs=(\d+) st=([01]) he=([01]) rs=([01])")
-_RX_PICK = re.compile(r"@IN p(\d)=(\d+)")
-_RX_OUT = re.compile(r"@OUT level=(\d) appr=([01]) latched=([01])")
+_RX = {
+    "cycle": re.compile(r"@IN cycle vs=(\d+) st=([01]) he=([01]) rs=([01])"),
+    "pick": re.compile(r"@IN p(\d)=(\d+)"),
+    "out": re.compile(r"@OUT level=(\d) appr=([01]) latched=([01])"),
+}
 
 
 
@@ -42,24 +44,20 @@ class Braking(Part):
         """Replay/simulation output -> list of (inputs, outputs) per cycle. A cycle is complete
         with its @OUT line; a cycle cut off by the end of a trail or walk is dropped."""
         events, pending = [], None
-        for line in text.splitlines():
-            if "@IN" not in line and "@OUT" not in line:
-                continue
-            if m := _RX_CYCLE.search(line):
+        for kind, m, line in model_lines(text, _RX):
+            if kind == "cycle":
                 pending = {"v_s": int(m[1]), "standstill": m[2] == "1", "handle_emergency": m[3] == "1",
                            "reset": m[4] == "1"}
-            elif m := _RX_PICK.search(line):
+            elif kind == "pick":
                 k = int(m[1])
                 if pending is None or k >= len(PATTERNS) or PATTERNS[k] in pending:
                     raise PipelineError(f"pattern speed outside a cycle or repeated: {line.strip()}")
                 pending[PATTERNS[k]] = int(m[2])
-            elif m := _RX_OUT.search(line):
+            else:
                 if pending is None or any(p not in pending for p in PATTERNS):
                     raise PipelineError(f"@OUT without a complete @IN cycle: {line.strip()}")
                 events.append((pending, {"level": int(m[1]), "appr": m[2] == "1", "latched": m[3] == "1"}))
                 pending = None
-            else:
-                raise PipelineError(f"unrecognised model output line: {line.strip()}")
         return events
 
     def to_steps(self, events, bounds, define):

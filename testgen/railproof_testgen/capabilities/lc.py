@@ -30,7 +30,7 @@ from pathlib import Path
 
 from ..errors import PipelineError, SpecError
 from ..spin import model_text
-from ..vectors import Configuration, Part, model_bounds
+from ..vectors import Configuration, Part, model_bounds, model_lines
 
 TICK_MS = 10_000
 CELL_MM = 100_000
@@ -166,6 +166,20 @@ def _failure(prev_state, state, prev_failure):
     return prev_failure if state == "FAILED" else "NONE"
 
 
+def _controller_state(k, c, o, now, t, state, ws, failure):
+    """The state controller c takes in tick k (the model's output o: cs, new, wa); its
+    warning start ws[c], failure[c] and state[c] are updated and its warning age checked."""
+    new_state = CONTROLLER_STATES[o["cs"]]
+    if o["new"]:
+        ws[c] = now
+    failure[c] = _failure(state[c], new_state, failure[c])
+    if new_state in ("WARNING", "CLOSING", "CLOSED") or (new_state == "FAILED" and failure[c] != "BARRIER_NOT_UP"):
+        if min((now - ws[c]) // TICK_MS, t["W"]) != o["wa"]:
+            raise PipelineError(f"tick {k}: controller {c}: warning age {o['wa']} disagrees with ws {ws[c]}")
+    state[c] = new_state
+    return new_state
+
+
 def onboard_steps(ticks, b: dict, config):
     """Raw ONBOARD ticks -> vector steps (controllers' cycles, then the on-board cycle)."""
     t = timing(b, config)
@@ -199,14 +213,7 @@ def onboard_steps(ticks, b: dict, config):
                     requesters[c].remove(tr)
             if (TRAIN_ID in requesters[c]) != bool(o["rq"]):
                 raise PipelineError(f"tick {k}: controller {c}: requester tracking disagrees with the model")
-            new_state = CONTROLLER_STATES[o["cs"]]
-            if o["new"]:
-                ws[c] = now
-            failure[c] = _failure(state[c], new_state, failure[c])
-            if new_state in ("WARNING", "CLOSING", "CLOSED") or (new_state == "FAILED" and failure[c] != "BARRIER_NOT_UP"):
-                if min((now - ws[c]) // TICK_MS, t["W"]) != o["wa"]:
-                    raise PipelineError(f"tick {k}: controller {c}: warning age {o['wa']} disagrees with ws {ws[c]}")
-            state[c] = new_state
+            new_state = _controller_state(k, c, o, now, t, state, ws, failure)
             status = STATUS_OF[new_state]
             rep = _report(CROSSING_IDS[c], status, ws[c] if status != "OPEN" else 0, now,
                           list(requesters[c]))
@@ -334,14 +341,7 @@ def gnss_steps(ticks, b: dict, config):
                 src = centre_out[k - dm["age"]]
                 sts.extend(m for m in src["start_times"] if m["crossing_id"] == CROSSING_IDS[c])
                 stops.extend(m for m in src["warning_stops"] if m["crossing_id"] == CROSSING_IDS[c])
-            new_state = CONTROLLER_STATES[g["cs"]]
-            if g["new"]:
-                ws[c] = now
-            failure[c] = _failure(state[c], new_state, failure[c])
-            if new_state in ("WARNING", "CLOSING", "CLOSED") or (new_state == "FAILED" and failure[c] != "BARRIER_NOT_UP"):
-                if min((now - ws[c]) // TICK_MS, t["W"]) != g["wa"]:
-                    raise PipelineError(f"tick {k}: controller {c}: warning age {g['wa']} disagrees with ws {ws[c]}")
-            state[c] = new_state
+            new_state = _controller_state(k, c, g, now, t, state, ws, failure)
             clock_state = CLOCK_STATES[g["ck"]]
             status = STATUS_OF[new_state]
             rep = _report(CROSSING_IDS[c], status, ws[c] if status != "OPEN" else 0, now, [],
@@ -396,13 +396,7 @@ class LevelCrossing(Part):
         begins with its @IN tick line and is complete with @OUT move; a tick cut off by the end of
         a trail or walk is dropped."""
         ticks, cur = [], None
-        for line in text.splitlines():
-            if "@IN" not in line and "@OUT" not in line:
-                continue
-            kind = next((k for k, rx in _RX.items() if rx.search(line)), None)
-            if kind is None:
-                raise PipelineError(f"unrecognised model output line: {line.strip()}")
-            m = _RX[kind].search(line)
+        for kind, m, line in model_lines(text, _RX):
             g = [int(x) if x is not None else None for x in m.groups()]
             if kind == "tick":
                 cur = {"t": g[0], "x": g[1], "v": g[2], "ph": g[3], "dw": g[4], "ul": [], "other": None, "bar": {},

@@ -11,7 +11,7 @@ from __future__ import annotations
 import re
 
 from ..errors import PipelineError
-from ..vectors import Configuration, Part, model_bounds
+from ..vectors import Configuration, Part, model_bounds, model_lines
 
 NOTEL = -9
 KINDS = ["NONE", "PRECEDING_TRAIN", "FIXED_BLOCK", "ROUTE_END", "HANDOVER", "SYSTEM_BOUNDARY",
@@ -89,40 +89,36 @@ class MovingBlock(Part):
         """Replay/simulation output -> list of raw (input, output) events; a tick's output is
         complete only with its `@OUT il` line (an input cut off by the end of a trail is dropped)."""
         events, pending, trains = [], None, []
-        for line in text.splitlines():
-            if "@IN" not in line and "@OUT" not in line:
-                continue
-            if m := _RX["env_in"].search(line):
+        for kind, m, line in model_lines(text, _RX):
+            if kind == "env_in":
                 pending = {"ev": "cmd", "cmd": int(m[1]), "arg": int(m[2])}
-            elif m := _RX["rep_in"].search(line):
+            elif kind == "rep_in":
                 pending = {"ev": "report", "t": int(m[1]), "front": int(m[2]), "ext": int(m[3])}
-            elif _RX["tick_in"].search(line):
+            elif kind == "tick_in":
                 pending, trains = {"ev": "tick"}, []
-            elif m := _RX["dl_in"].search(line):
+            elif kind == "dl_in":
                 pending = {"ev": "deliver", "t": int(m[1]), "lim": int(m[2]), "age": int(m[3])}
-            elif m := _RX["env_out"].search(line):
+            elif kind == "env_out":
                 _expect(pending, "cmd", line)
                 events.append((pending, {"poss": int(m[1]), "side_req": int(m[2])}))
                 pending = None
-            elif m := _RX["rep_out"].search(line):
+            elif kind == "rep_out":
                 _expect(pending, "report", line)
                 events.append((pending, {"tracked": int(m[2])}))
                 pending = None
-            elif m := _RX["train_out"].search(line):
+            elif kind == "train_out":
                 _expect(pending, "tick", line)
                 trains.append({"t": int(m[1]), "grant": int(m[2]), "why": int(m[3]), "abn": int(m[4]),
                                "usable": int(m[5])})
-            elif m := _RX["il_out"].search(line):
+            elif kind == "il_out":
                 _expect(pending, "tick", line)
                 events.append((pending, {"trains": trains, "main": int(m[1]), "side": int(m[2]),
                                          "pts": int(m[3]), "poss": int(m[4]), "occ": int(m[5])}))
                 pending, trains = None, []
-            elif m := _RX["dl_out"].search(line):
+            else:
                 _expect(pending, "deliver", line)
                 events.append((pending, {"verdict": int(m[2]), "lim": int(m[3])}))
                 pending = None
-            else:
-                raise PipelineError(f"unrecognised model output line: {line.strip()}")
         return events
 
     def to_steps(self, events, b, define):

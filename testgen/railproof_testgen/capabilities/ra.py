@@ -17,7 +17,7 @@ from __future__ import annotations
 import re
 
 from ..errors import PipelineError
-from ..vectors import Configuration, Part, model_bounds
+from ..vectors import Configuration, Part, model_bounds, model_lines
 
 # ra::Mode and ra::StopReason in order, named as their ToString
 MODES = ["TG", "COMPENSATING", "STOPPED"]
@@ -60,19 +60,15 @@ class ReAdhesion(Part):
         A cycle is complete with its @OUT line; a cycle cut off by the end of a trail or walk is
         dropped."""
         events, pending = [], None
-        for line in text.splitlines():
-            if "@IN" not in line and "@OUT" not in line:
-                continue
-            if m := _RX_IN.search(line):
+        for kind, m, line in model_lines(text, {"in": _RX_IN, "out": _RX_OUT}):
+            if kind == "in":
                 pending = {"dev": m[1] == "1", "sa": [m[2] == "1", m[3] == "1"], "imu": m[4] == "1",
                            "tg": m[5] == "1", "bal": m[6] == "1", "sec": int(m[7]), "age": int(m[8])}
-            elif m := _RX_OUT.search(line):
-                if pending is None:
-                    raise PipelineError(f"@OUT without its @IN cycle: {line.strip()}")
+            elif pending is None:
+                raise PipelineError(f"@OUT without its @IN cycle: {line.strip()}")
+            else:
                 events.append((pending, {k: int(v) for k, v in zip(_OUT_KEYS, m.groups())}))
                 pending = None
-            else:
-                raise PipelineError(f"unrecognised model output line: {line.strip()}")
         return events
 
     def to_steps(self, events, b, define):

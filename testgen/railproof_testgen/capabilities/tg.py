@@ -36,8 +36,11 @@ IDENTIFIERS = ("ground_id", "train_id", "other_train_id")
 
 _IN_TICK = re.compile(r"@IN tick")
 _IN_RX = re.compile(r"@IN rx seq=(\d+) echo=(\d+) mode=(\d+)")
-_OUT_TX = re.compile(r"@OUT tx seq=(\d+) echo=(\d+) link=(\d+) eb=(\d+) abnormal=(\d+)")
-_OUT_RX = re.compile(r"@OUT rx verdict=(\d+) gap=(\d+) link=(\d+) eb=(\d+) abnormal=(\d+)")
+# an output line: its name, the input it answers, its fields in order
+_OUTPUTS = ((re.compile(r"@OUT tx seq=(\d+) echo=(\d+) link=(\d+) eb=(\d+) abnormal=(\d+)"), "tx", "tick",
+             ("seq", "echo", "link", "eb", "abnormal")),
+            (re.compile(r"@OUT rx verdict=(\d+) gap=(\d+) link=(\d+) eb=(\d+) abnormal=(\d+)"), "rx", "rx",
+             ("verdict", "gap", "link", "eb", "abnormal")))
 
 
 def _role_out(role, o):
@@ -75,18 +78,14 @@ class Telegram(Part):
                 pending = {"ev": "tick"}
             elif m := _IN_RX.search(line):
                 pending = {"ev": "rx", "seq": int(m[1]), "echo": int(m[2]), "mode": int(m[3])}
-            elif m := _OUT_TX.search(line):
-                if pending is None or pending["ev"] != "tick":
-                    raise PipelineError(f"@OUT tx without @IN tick: {line.strip()}")
-                events.append((pending, {"seq": int(m[1]), "echo": int(m[2]), "link": int(m[3]),
-                                         "eb": int(m[4]), "abnormal": int(m[5])}))
-                pending = None
-            elif m := _OUT_RX.search(line):
-                if pending is None or pending["ev"] != "rx":
-                    raise PipelineError(f"@OUT rx without @IN rx: {line.strip()}")
-                events.append((pending, {"verdict": int(m[1]), "gap": int(m[2]), "link": int(m[3]),
-                                         "eb": int(m[4]), "abnormal": int(m[5])}))
-                pending = None
+            else:
+                for rx, name, ev, fields in _OUTPUTS:
+                    if m := rx.search(line):
+                        if pending is None or pending["ev"] != ev:
+                            raise PipelineError(f"@OUT {name} without @IN {ev}: {line.strip()}")
+                        events.append((pending, {f: int(v) for f, v in zip(fields, m.groups())}))
+                        pending = None
+                        break
         return events
 
     def to_steps(self, events, bounds, define, role="ground"):

@@ -22,6 +22,7 @@ from __future__ import annotations
 import shlex
 from pathlib import Path
 
+from .. import SPEC_DIR, add_command
 from ..errors import PipelineError
 from .context import Context
 from .inputs import Inputs, load_inputs
@@ -92,16 +93,13 @@ def _run(a) -> int:
 
 
 def register(sub):
-    p = sub.add_parser(
-        "evidence",
-        help="render the assessor's evidence package (Sphinx + sphinx-needs) and its manifest",
-        description="Render spec/ and the build's results into an HTML evidence package with "
-                    "Sphinx, sphinx-needs and sphinx-test-reports, and write a SHA-256 manifest. "
-                    "The verdict (PASS or FAIL, with every reason) is in OUT/evidence.json.")
-    p.add_argument("--spec", required=True, help="spec/ directory")
-    p.add_argument("--results", required=True,
-                   help="the build's results directory (registry.json, trace.json, spin/, vectors/, "
-                        "tests/, analysis/, proofs/, layout.json, tool-versions.json, ...)")
-    p.add_argument("--src", required=True, help="repository root (its evidence/ holds the sources)")
-    p.add_argument("--out", required=True, help="output directory (inputs/, src/, html/, manifest)")
-    p.set_defaults(func=_run)
+    add_command(sub, "evidence", _run,
+                "render the assessor's evidence package (Sphinx + sphinx-needs) and its manifest",
+                """Render spec/ and the build's results into an HTML evidence package with
+                Sphinx, sphinx-needs and sphinx-test-reports, and write a SHA-256 manifest. The
+                verdict (PASS or FAIL, with every reason) is in OUT/evidence.json.""",
+                spec=SPEC_DIR,
+                results="the build's results directory (registry.json, trace.json, spin/, vectors/, "
+                        "tests/, analysis/, proofs/, layout.json, tool-versions.json, ...)",
+                src="repository root (its evidence/ holds the sources)",
+                out="output directory (inputs/, src/, html/, manifest)")

@@ -246,14 +246,12 @@ def load_vectors(inp: Inputs) -> None:
     seen: dict = {}
     for f in sorted(vdir.glob("*.jsonl")):
         header, vectors = None, []
+
+        def malformed(lineno, exc, f=f):
+            raise PipelineError(f"{f}: line {lineno}: malformed JSON: {exc.msg}") from None
+
         with f.open(encoding="utf-8") as fh:
-            for lineno, line in enumerate(fh, 1):
-                if not line.strip():
-                    continue
-                try:
-                    obj = json.loads(line)
-                except json.JSONDecodeError as exc:
-                    raise PipelineError(f"{f}: line {lineno}: malformed JSON: {exc.msg}") from None
+            for lineno, obj in spec_mod.jsonl_records(fh, malformed):
                 require(isinstance(obj, dict), f, f"line {lineno}", "must be an object")
                 if obj.get("kind") == "header":
                     require(header is None and not vectors, f, f"line {lineno}",
