@@ -14,7 +14,7 @@ set(RAILPROOF_VECTOR_DIR ${RAILPROOF_RESULTS_DIR}/vectors)
 set(_tg ${RAILPROOF_SOURCE_DIR}/testgen/railproof_testgen)
 # what every testgen command runs (the command line and its error types); each step adds the
 # modules it runs (the command line imports only the module of the command)
-set(_tg_base ${_tg}/__init__.py ${_tg}/__main__.py ${_tg}/errors.py)
+set(_tg_base ${_tg}/__init__.py ${_tg}/__main__.py ${_tg}/errors.py ${_tg}/files.py)
 set(_tg_spin ${_tg_base} ${_tg}/spin.py)
 # the vector engine and what it finds a model's capability part with (the registry)
 set(_tg_engine ${_tg}/vectors.py ${_tg}/spec.py ${_tg}/registry.py ${_tg}/capabilities/__init__.py
@@ -149,7 +149,7 @@ set(_tools ${RAILPROOF_RESULTS_DIR}/tool-versions.json)
 add_custom_command(
   OUTPUT ${_tools}
   COMMAND ${RAILPROOF_TESTGEN} toolversions --out ${_tools} --compiler ${CMAKE_CXX_COMPILER}
-  DEPENDS ${RAILPROOF_SOURCE_DIR}/testgen/requirements.txt ${_tg}/toolversions.py
+  DEPENDS ${RAILPROOF_SOURCE_DIR}/testgen/requirements.txt ${_tg_base} ${_tg}/toolversions.py
   COMMENT "evidence: recording tool versions" VERBATIM)
 
 set(_trace ${RAILPROOF_RESULTS_DIR}/trace.json)

@@ -14,8 +14,8 @@ file(GLOB RAILPROOF_SPEC_DATA_FILES CONFIGURE_DEPENDS
 # The spec steps depend on the testgen modules they run, not on all of testgen: a change to
 # the evidence code does not regenerate the parameter headers (and re-verify every model).
 set(_tgm ${RAILPROOF_SOURCE_DIR}/testgen/railproof_testgen)
-set(RAILPROOF_SPEC_TOOL_FILES ${_tgm}/__init__.py ${_tgm}/__main__.py ${_tgm}/errors.py ${_tgm}/spec.py
-    ${_tgm}/validate.py ${_tgm}/lines.py ${_tgm}/trains.py ${_tgm}/timetables.py ${_tgm}/params.py)
+set(RAILPROOF_SPEC_TOOL_FILES ${_tgm}/__init__.py ${_tgm}/__main__.py ${_tgm}/errors.py ${_tgm}/files.py ${_tgm}/spec.py
+    ${_tgm}/checks.py ${_tgm}/validate.py ${_tgm}/lines.py ${_tgm}/trains.py ${_tgm}/timetables.py ${_tgm}/params.py)
 # One C++ header and one Promela header per parameter file, named after the file
 # (spec/parameters/<name>.yaml -> <name>_params.hpp / .pml; gen-params checks the name).
 file(GLOB RAILPROOF_PARAM_FILES CONFIGURE_DEPENDS ${RAILPROOF_SOURCE_DIR}/spec/parameters/*.yaml)

@@ -30,6 +30,7 @@ from pathlib import Path
 
 from . import add_command
 from .errors import PipelineError
+from .files import write_json
 
 RUNTIME_EXTERNAL = {"PkgConfig::SODIUM"}
 SIDES = ("common", "onboard", "wayside")
@@ -127,12 +128,8 @@ def run(args) -> int:
     for e in errors:
         print(e, file=sys.stderr)
     if args.out:
-        out = Path(args.out)
-        out.parent.mkdir(parents=True, exist_ok=True)
-        tmp = out.with_suffix(".tmp")
-        tmp.write_text(json.dumps({"schema": "railproof/layout/1", "violations": errors, "targets": report},
-                                  indent=2, sort_keys=True) + "\n", encoding="utf-8")
-        tmp.replace(out)
+        write_json(Path(args.out), {"schema": "railproof/layout/1", "violations": errors,
+                                    "targets": report}, if_changed=False)
     if errors:
         print(f"layout: {len(errors)} boundary violation(s)", file=sys.stderr)
         return 1

@@ -58,9 +58,10 @@ from pathlib import Path
 
 from . import SPEC_DIR, add_command
 from . import spec as spec_mod
-from . import validate as vmod
+from .files import write_atomic
+from . import checks
 from .errors import SpecError
-from .validate import label as _label
+from .checks import label as _label
 
 SUB = "lines"
 SCHEMA_FILE = "line.schema.json"
@@ -226,7 +227,7 @@ class _Line:
         if d["name"] != f.stem:
             self.err("name", f"{d['name']!r} must equal the file name {f.stem!r}")
         for i, s in enumerate(d["source"]):
-            if not vmod.CITATION.search(s):
+            if not checks.CITATION.search(s):
                 self.err(f"source[{i}]", f"{s!r} cites no D1-D5 section, ASM-NNN or named "
                                          "standard")
         L = self.mm("length_m", "length_m", d["length_m"])
@@ -843,18 +844,18 @@ def check_lines(spec_dir, report):
     lc_limits = _CrossingLimits.from_spec(spec_dir)
 
     def check(f, data):
-        refs.extend(vmod.provenance_refs(f, data["name"], data))
+        refs.extend(checks.provenance_refs(f, data["name"], data))
         obj = _Line(f, data, report, max_blocks, lc_limits).check()
         if obj is not None:
             outputs[data["name"]] = obj
 
-    vmod.check_data_files(spec_dir, line_files(spec_dir), SCHEMA_FILE, report, check)
+    checks.check_data_files(spec_dir, line_files(spec_dir), SCHEMA_FILE, report, check)
     return outputs, refs
 
 
 def build(spec_dir):
     """(outputs, report) for spec_dir: all line files checked, references resolved."""
-    return vmod.checked_directory(spec_dir, SUB, "line", check_lines,
+    return checks.checked_directory(spec_dir, SUB, "line", check_lines,
                                   lambda _outputs: line_files(spec_dir))
 
 
@@ -862,9 +863,9 @@ def generate(spec_dir, out_dir):
     """Validate spec/lines and write OUT/<name>.json; raises SpecError (first error, with
     the count of the others) and writes nothing if any line file is invalid."""
     outputs, report = build(spec_dir)
-    vmod.raise_first(report)
+    checks.raise_first(report)
     for name, obj in sorted(outputs.items()):
-        spec_mod.write_atomic(Path(out_dir) / f"{name}.json", spec_mod.render_json(obj))
+        write_atomic(Path(out_dir) / f"{name}.json", spec_mod.render_json(obj))
     return sorted(outputs)
 
 
@@ -876,7 +877,7 @@ def _converted(name, obj, path):
 
 
 def run(args):
-    return vmod.convert(SUB, args, build, _converted)
+    return checks.convert(SUB, args, build, _converted)
 
 
 def register(sub):

@@ -6,6 +6,7 @@ from pathlib import Path
 
 from . import SPEC_DIR, add_command
 from . import spec as spec_mod
+from .files import write_atomic
 
 _IDENT = re.compile(r"^[a-z][a-z0-9_]*$")
 
@@ -45,9 +46,9 @@ def generate(spec_dir: Path, out_dir: Path):
             if ns:
                 lines.append(f"}}  // namespace {ns}")
         lines.append(f"}}  // namespace railproof::params::{name}")
-        spec_mod.write_atomic(Path(out_dir) / "include/railproof/generated" / f"{name}_params.hpp",
+        write_atomic(Path(out_dir) / "include/railproof/generated" / f"{name}_params.hpp",
                           "\n".join(lines) + "\n")
-        spec_mod.write_atomic(Path(out_dir) / "models" / f"{name}_params.pml", "\n".join(pml) + "\n")
+        write_atomic(Path(out_dir) / "models" / f"{name}_params.pml", "\n".join(pml) + "\n")
 
 
 def register(sub):

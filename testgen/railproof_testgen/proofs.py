@@ -70,7 +70,7 @@ from pathlib import Path
 
 from . import SPEC_DIR, add_command
 from .errors import PipelineError, SpecError
-from .spec import write_atomic
+from .files import write_atomic
 
 SCHEMA = "railproof/proofs/1"
 SOLVERS = ("z3", "cvc5")

@@ -36,7 +36,8 @@ import jsonschema
 from . import SPEC_DIR, add_command
 from . import spin as spin_mod
 from .errors import SpecError
-from .spec import load_yaml, write_atomic
+from .files import write_atomic
+from .spec import load_yaml
 
 REGISTRY = "capabilities.yaml"
 SCHEMA = "schemas/capabilities.schema.json"

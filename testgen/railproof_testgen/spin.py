@@ -24,7 +24,6 @@ from __future__ import annotations
 
 import errno
 import hashlib
-import json
 import os
 import re
 import shutil
@@ -37,6 +36,7 @@ from pathlib import Path
 
 from . import add_command
 from .errors import PipelineError, SpecError
+from .files import write_json
 
 _REQ_ID = r"REQ-[A-Z]{2}-\d{3}"
 _REQ = re.compile(_REQ_ID)
@@ -622,10 +622,7 @@ def verify(model: Path, params_dir: Path, workdir: Path, out_json: Path, jobs: i
         "wall_time_s": round(time.monotonic() - t0, 1),
     }
     out_json = Path(out_json)
-    out_json.parent.mkdir(parents=True, exist_ok=True)
-    tmp = out_json.with_suffix(".tmp")
-    tmp.write_text(json.dumps(result, indent=2, sort_keys=True) + "\n", encoding="utf-8")
-    tmp.replace(out_json)
+    write_json(out_json, result, if_changed=False)
 
     failures = [p for p in props if p["verdict"] != "verified"]
     survivors = [m for m in mutants if m["verdict"] != "rejected"]

@@ -27,13 +27,12 @@ Rules after the schema (entries such as ``services[R105].stops[0]``):
 """
 from __future__ import annotations
 
-import sys
 from decimal import Decimal
 from pathlib import Path
 
 from . import SPEC_DIR, add_command
 from . import spec as spec_mod
-from . import validate as vmod
+from . import checks
 
 SUB = "timetables"
 SCHEMA_FILE = "timetable.schema.json"
@@ -88,7 +87,7 @@ class _Timetable:
         d, f = self.d, self.f
         if d["name"] != f.stem:
             self.err("name", f"{d['name']!r} must equal the file name {f.stem!r}")
-        if not vmod.check_sources(self.report, f, d["name"], d["source"]):
+        if not checks.check_sources(self.report, f, d["name"], d["source"]):
             self.ok = False
         step = self.ms("planned_time_step_s", d.get("planned_time_step_s",
                                                    DEFAULT_PLANNED_TIME_STEP_S))
@@ -127,20 +126,20 @@ class _Timetable:
     def _line(self):
         line = self.lines.get(self.d["line"])
         if line is None:
-            self.err("line", vmod.missing_data(self.spec_dir, "lines", self.d["line"], "line"))
+            self.err("line", checks.missing_data(self.spec_dir, "lines", self.d["line"], "line"))
         return line
 
     def _services(self, line, min_dwell_ms):
         out, ids, last_departure = [], {}, {}
         for i, sv in enumerate(self.d["services"]):
-            entry = vmod.label("services", sv, i)
+            entry = checks.label("services", sv, i)
             if sv["id"] in ids:
                 self.err(entry, f"id: duplicate service id {sv['id']!r} (first used by "
                                 f"services[{ids[sv['id']]}])")
             ids.setdefault(sv["id"], i)
             train = self.trains.get(sv["train"])
             if train is None:
-                self.err(f"{entry}.train", vmod.missing_data(self.spec_dir, "trains",
+                self.err(f"{entry}.train", checks.missing_data(self.spec_dir, "trains",
                                                              sv["train"], "train type"))
             stops = self._stops(entry, sv, min_dwell_ms)
             depart = clock_ms(sv["depart"])
@@ -252,12 +251,12 @@ def check_timetables(spec_dir, report, lines, trains):
     outputs, refs = {}, []
 
     def check(f, data):
-        refs.extend(vmod.provenance_refs(f, data["name"], data))
+        refs.extend(checks.provenance_refs(f, data["name"], data))
         obj = _Timetable(spec_dir, f, data, report, lines, trains).check()
         if obj is not None:
             outputs[data["name"]] = obj
 
-    vmod.check_data_files(spec_dir, timetable_files(spec_dir), SCHEMA_FILE, report, check)
+    checks.check_data_files(spec_dir, timetable_files(spec_dir), SCHEMA_FILE, report, check)
     return outputs, refs
 
 
@@ -266,17 +265,17 @@ def build(spec_dir):
     of spec_dir (their own errors are reported by the lines and trains steps)."""
     from . import lines as lines_mod
     from . import trains as trains_mod
-    report = vmod.Report()
+    report = checks.Report()
     spec_dir = Path(spec_dir)
     if not timetable_files(spec_dir):
         report.error(spec_dir / SUB, "-", "no timetable files (*.yaml)")
         return {}, report
-    others = vmod.Report()  # the lines' and trains' own findings belong to their steps
+    others = checks.Report()  # the lines' and trains' own findings belong to their steps
     lines, _ = lines_mod.check_lines(spec_dir, others)
     trains, _ = trains_mod.check_trains(spec_dir, others)
     outputs, refs = check_timetables(spec_dir, report, lines,
                                      {n: t for (m, n), t in trains.items() if not m})
-    vmod.check_assumption_refs(spec_dir, refs, report)
+    checks.check_assumption_refs(spec_dir, refs, report)
     return outputs, report
 
 
@@ -285,7 +284,7 @@ def _converted(name, obj, path):
 
 
 def run(args):
-    return vmod.convert(SUB, args, build, _converted)
+    return checks.convert(SUB, args, build, _converted)
 
 
 def register(sub):

@@ -2,7 +2,6 @@
 in the evidence package, which also names the versions of DOC_PACKAGES it was rendered with)."""
 from __future__ import annotations
 
-import json
 import platform
 import re
 import subprocess
@@ -10,6 +9,7 @@ from importlib import metadata
 from pathlib import Path
 
 from . import add_command
+from .files import write_json
 
 DEBIAN_PACKAGES = ["spin", "cmake", "ninja-build", "g++", "clang", "libgtest-dev", "libbenchmark-dev",
                    "libsodium-dev", "coinor-libipopt-dev", "libompl-dev", "libbox2d-dev", "nlohmann-json3-dev",
@@ -58,11 +58,7 @@ def collect(compiler: str | None = None) -> dict:
 
 def register(sub):
     def run(a):
-        path = Path(a.out)
-        path.parent.mkdir(parents=True, exist_ok=True)
-        tmp = path.with_suffix(".tmp")
-        tmp.write_text(json.dumps(collect(a.compiler), indent=2, sort_keys=True) + "\n", encoding="utf-8")
-        tmp.replace(path)
+        write_json(Path(a.out), collect(a.compiler), if_changed=False)
 
     add_command(sub, "toolversions", run, "write the versions of the tool chain as JSON",
                 out={"required": True}, compiler={"default": None})

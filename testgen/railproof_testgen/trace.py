@@ -62,8 +62,10 @@ from pathlib import Path
 from . import SPEC_DIR, add_command
 from . import registry as registry_mod
 from .errors import SpecError
-from .spec import jsonl_records, write_atomic
-from .validate import REQ_ID, Report, check_spec
+from .files import write_atomic
+from .spec import jsonl_records
+from .checks import REQ_ID, Report
+from .validate import check_spec
 
 SCHEMA = "railproof/trace/1"
 LINK_KINDS = ("model", "goals", "vectors", "unit", "code", "tool", "analysis", "proof")

@@ -23,8 +23,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from . import SPEC_DIR, add_command
-from . import validate as vmod
-from .errors import SpecError
+from . import checks
 
 SUB = "trains"
 MUTANTS = "mutants"
@@ -57,7 +56,7 @@ def _check(f, data, report, mutant):
     if name != f.stem:
         report.error(f, name, f"name {name!r} must equal the file name {f.stem!r}")
         ok = False
-    if not vmod.check_sources(report, f, name, data["source"]):
+    if not checks.check_sources(report, f, name, data["source"]):
         ok = False
     for group, key in _RANGES:
         lo, hi = data[group][key]
@@ -90,17 +89,17 @@ def check_trains(spec_dir, report, with_mutants=False):
             ([(True, sorted((root / MUTANTS).glob("*.yaml")))] if with_mutants else []):
 
         def check(f, data, mutant=mutant):
-            refs.extend(vmod.provenance_refs(f, data["name"], data))
+            refs.extend(checks.provenance_refs(f, data["name"], data))
             obj = _check(f, data, report, mutant)
             if obj is not None:
                 outputs[(mutant, data["name"])] = obj
 
-        vmod.check_data_files(spec_dir, files, SCHEMA_FILE, report, check)
+        checks.check_data_files(spec_dir, files, SCHEMA_FILE, report, check)
     return outputs, refs
 
 
 def build(spec_dir):
-    return vmod.checked_directory(spec_dir, SUB, "train type",
+    return checks.checked_directory(spec_dir, SUB, "train type",
                                   lambda d, report: check_trains(d, report, with_mutants=True),
                                   lambda outputs: any(not m for m, _ in outputs))
 
@@ -116,7 +115,7 @@ def _output_path(key):
 
 
 def run(args):
-    return vmod.convert(SUB, args, build, _converted, _output_path)
+    return checks.convert(SUB, args, build, _converted, _output_path)
 
 
 def register(sub):

@@ -32,303 +32,18 @@ Warnings: an assumption that nothing references; a SIL >= 3 requirement naming n
 """
 from __future__ import annotations
 
-import json
-import re
 import sys
-from dataclasses import dataclass, field
 from pathlib import Path
 
-import jsonschema
-
 from . import SPEC_DIR, add_command
+from . import lines as lines_mod
 from . import spec as spec_mod
+from . import timetables as timetables_mod
+from . import trains as trains_mod
+from .checks import (ASM_ID, CITATION, HAZ_ID, ID_TOKEN, KIND_WORD, KINDS, PREFIX_KIND, REQ_ID,
+                     UR_ID, Report, check_data_files, check_sources, label, load_schema,
+                     missing_data, raise_first, schema_errors)
 from .errors import SpecError
-
-AREAS = ("TG", "MB", "BR", "SC", "RA", "LC", "GN", "FC", "AV")
-METHODS = ("model", "vectors", "unit", "analysis", "proof", "review")
-_AREA_RE = "|".join(AREAS)
-REQ_ID = re.compile(rf"^REQ-({_AREA_RE})-\d{{3}}$")
-HAZ_ID = re.compile(r"^HAZ-\d{3}$")
-ASM_ID = re.compile(r"^ASM-\d{3}$")
-UR_ID = re.compile(rf"^UR-({_AREA_RE})-\d{{3}}$")
-
-# Anything that looks like an identifier of ours inside free text.
-ID_TOKEN = re.compile(r"\b(?:REQ|HAZ|ASM|UR)-[A-Za-z0-9]+(?:-[A-Za-z0-9]+)*")
-
-# A source citation: D1-D5 with a section or chapter, an assumption, or a named standard.
-CITATION = re.compile(
-    r"\bD[1-5]\s*(?:§\s*\d|chapters?\s+\d)"
-    r"|\bD3\b"  # D3 is a short article without numbered sections (digest §5)
-    r"|\bASM-\d{3}\b"
-    r"|\b(?:EN|IEC|ISO|IEEE|UIC|DIN|RFC|FIPS|CLC/TS|CLC/TR|ISO/IEC|NIST\s+SP)\s*[-:]?\s*\d"
-    r"|\bMISRA\b")
-
-# kind -> (sub-directory of spec/, list key, schema file, id pattern)
-KINDS = {
-    "requirements": ("requirements", "requirements", "requirements.schema.json", REQ_ID),
-    "hazards": ("hazards", "hazards", "hazards.schema.json", HAZ_ID),
-    "assumptions": ("assumptions", "assumptions", "assumptions.schema.json", ASM_ID),
-    "justifications": ("justifications", "justifications", "justifications.schema.json", UR_ID),
-    "parameters": ("parameters", None, "parameters.schema.json", None),
-}
-_PREFIX_KIND = {"REQ": "requirements", "HAZ": "hazards", "ASM": "assumptions",
-                "UR": "justifications"}
-_KIND_WORD = {"requirements": "requirement", "hazards": "hazard",
-              "assumptions": "assumption", "justifications": "justification"}
-
-
-@dataclass(frozen=True, order=True)
-class Finding:
-    """One reported problem: ``file: entry: reason``."""
-
-    file: str
-    entry: str
-    reason: str
-
-    def __str__(self):
-        return f"{self.file}: {self.entry}: {self.reason}"
-
-
-@dataclass
-class Report:
-    """Collects errors and warnings; nothing stops at the first finding."""
-
-    errors: list = field(default_factory=list)
-    warnings: list = field(default_factory=list)
-
-    def error(self, file, entry, reason):
-        f = Finding(str(file), str(entry), str(reason))
-        if f not in self.errors:
-            self.errors.append(f)
-        return f
-
-    def warn(self, file, entry, reason):
-        f = Finding(str(file), str(entry), str(reason))
-        if f not in self.warnings:
-            self.warnings.append(f)
-        return f
-
-    def print(self, stream=None):
-        stream = stream or sys.stderr
-        for w in self.warnings:
-            print(f"warning: {w}", file=stream)
-        for e in self.errors:
-            print(e, file=stream)
-
-
-_VALIDATORS = {}  # schema text -> validator (checking a schema against the meta-schema is slow)
-
-
-def _load_schema(spec_dir: Path, name: str):
-    path = Path(spec_dir) / "schemas" / name
-    try:
-        text = path.read_text(encoding="utf-8")
-        if text in _VALIDATORS:
-            return _VALIDATORS[text]
-        schema = json.loads(text)
-    except FileNotFoundError:
-        raise SpecError(path, "-", "schema file not found") from None
-    except json.JSONDecodeError as exc:
-        raise SpecError(path, f"line {exc.lineno}", f"malformed JSON: {exc.msg}") from None
-    try:
-        jsonschema.Draft202012Validator.check_schema(schema)
-    except jsonschema.SchemaError as exc:
-        raise SpecError(path, "/".join(map(str, exc.path)) or "-",
-                        f"invalid schema: {exc.message}") from None
-    _VALIDATORS[text] = jsonschema.Draft202012Validator(schema)
-    return _VALIDATORS[text]
-
-
-def _entry_name(data, path):
-    """Human name of the entry a schema error points at: its id if it has one."""
-    if not path:
-        return "-", ""
-    head = path[0]
-    if len(path) >= 2 and isinstance(path[1], int):
-        lst = data.get(head) if isinstance(data, dict) else None
-        item = lst[path[1]] if isinstance(lst, list) and path[1] < len(lst) else None
-        name = item.get("id") if isinstance(item, dict) else None
-        name = name if isinstance(name, str) and name else f"{head}[{path[1]}]"
-        rest = ".".join(str(p) if not isinstance(p, int) else f"[{p}]" for p in path[2:])
-        return name, rest.replace(".[", "[")
-    return str(head), ".".join(str(p) for p in path[1:])
-
-
-def _schema_errors(validator, data, file, report, entry_of=_entry_name):
-    """Report every schema error as ``file: entry: where: message`` (the entry named by
-    entry_of(data, path)); returns their number."""
-    n = 0
-    for err in sorted(validator.iter_errors(data), key=lambda e: [str(p) for p in e.path]):
-        entry, where = entry_of(data, list(err.path))
-        report.error(file, entry, f"{where}: {err.message}" if where else err.message)
-        n += 1
-    return n
-
-
-def label(section, item, index):
-    """Entry name of item `index` of list `section`: ``section[<id or name>]``, else the index."""
-    if isinstance(item, dict):
-        for key in ("id", "name"):
-            v = item.get(key)
-            if isinstance(v, (str, int)) and not isinstance(v, bool) and v != "":
-                return f"{section}[{v}]"
-    return f"{section}[{index}]"
-
-
-def _schema_entry(data, path):
-    """(entry, where) for a schema error at `path` inside `data` (data files: lists of
-    entries are named by label(), nested lists too, e.g. ``stations[S1].platforms[P2]``)."""
-    if not path:
-        return "-", ""
-    entry, node, rest = [], data, list(path)
-    consumed = 0
-    i = 0
-    while i < len(rest):
-        key = rest[i]
-        nxt = rest[i + 1] if i + 1 < len(rest) else None
-        if isinstance(key, str) and isinstance(nxt, int) and isinstance(node, dict) \
-                and isinstance(node.get(key), list):
-            lst = node[key]
-            item = lst[nxt] if nxt < len(lst) else None
-            entry.append(label(key, item, nxt))
-            node = item
-            i += 2
-            consumed = i
-            continue
-        break
-    if not entry:
-        return str(rest[0]), ".".join(str(p) for p in rest[1:])
-    return ".".join(entry), ".".join(str(p) for p in rest[consumed:])
-
-
-def data_schema_errors(validator, data, file, report):
-    """The schema errors of a data file (lines, trains, timetables, scenarios), entries
-    named by label()."""
-    return _schema_errors(validator, data, file, report, _schema_entry)
-
-
-def check_data_files(spec_dir, files, schema_name, report, check, load=spec_mod.load_yaml):
-    """The one loop over the data files of spec/: load each file, check it against
-    spec/schemas/<schema_name>, and call check(file, data) for every schema-valid file.
-    Nothing stops at the first finding."""
-    if not files:
-        return
-    try:
-        validator = _load_schema(spec_dir, schema_name)
-    except SpecError as exc:
-        report.error(exc.file, exc.entry, exc.reason)
-        return
-    for f in files:
-        try:
-            data = load(f)
-        except SpecError as exc:
-            report.error(exc.file, exc.entry, exc.reason)
-            continue
-        if data_schema_errors(validator, data, f, report):
-            continue
-        check(f, data)
-
-
-def check_sources(report, file, entry, sources):
-    """Every source string cites D1-D5 with a section, an ASM-NNN or a named standard;
-    returns False if one does not."""
-    ok = True
-    for i, s in enumerate(sources):
-        if isinstance(s, str) and not CITATION.search(s):
-            report.error(file, entry, f"source[{i}] {s!r} cites no D1-D5 section, ASM-NNN or "
-                                      "named standard")
-            ok = False
-    return ok
-
-
-def provenance_refs(file, name, data):
-    """(file, entry, field, text) of a data file's assumption and sources, for the check
-    that the assumptions they name exist."""
-    refs = [(file, name, "assumption", data["assumption"])] if "assumption" in data else []
-    refs.extend((file, name, f"source[{i}]", s) for i, s in enumerate(data.get("source") or []))
-    return refs
-
-
-def known_assumptions(spec_dir, report):
-    """Ids of spec/assumptions, or None if a file cannot be read (reported)."""
-    ids = set()
-    for f in spec_mod.spec_files(spec_dir, "assumptions"):
-        try:
-            data = spec_mod.load_yaml(f)
-        except SpecError as exc:
-            report.error(exc.file, exc.entry, exc.reason)
-            return None
-        for e in data.get("assumptions") or []:
-            if isinstance(e, dict) and isinstance(e.get("id"), str):
-                ids.add(e["id"])
-    return ids
-
-
-def check_assumption_refs(spec_dir, refs, report):
-    """Every ASM-NNN named by a data file must exist in spec/assumptions (used by the
-    single-kind commands lines, trains and timetables; validate checks every kind of
-    reference)."""
-    known = known_assumptions(spec_dir, report)
-    if known is None:
-        return
-    for f, entry, where, s in refs:
-        for token in ID_TOKEN.findall(s):
-            if token.startswith("ASM-") and ASM_ID.match(token) and token not in known:
-                report.error(f, entry, f"{where}: unknown assumption {token}")
-            elif token.startswith("ASM-") and not ASM_ID.match(token):
-                report.error(f, entry, f"{where}: malformed reference {token!r}")
-
-
-def missing_data(spec_dir, sub, name, what):
-    """Reason for a name that no valid file of spec/<sub> defines."""
-    path = Path(spec_dir) / sub / f"{name}.yaml"
-    if path.exists():
-        return f"{what} {name!r} has errors ({sub}/{path.name}, reported by validate)"
-    return f"unknown {what} {name!r} (no {sub}/{path.name})"
-
-
-def checked_directory(spec_dir, sub, what, check, found):
-    """(outputs, report) of the data directory spec/<sub> (what: "line", "train type"): an
-    error if it is missing; else check(spec_dir, report) -> (outputs, refs), an error if
-    found(outputs) says it holds no file of its kind, and the assumption references."""
-    report = Report()
-    spec_dir = Path(spec_dir)
-    if not (spec_dir / sub).is_dir():
-        report.error(spec_dir / sub, "-", f"{what} directory not found")
-        return {}, report
-    outputs, refs = check(spec_dir, report)
-    if not found(outputs) and not report.errors:
-        report.error(spec_dir / sub, "-", f"no {what} files (*.yaml)")
-    check_assumption_refs(spec_dir, refs, report)
-    return outputs, report
-
-
-def convert(command, args, build, describe, path_of=lambda name: f"{name}.json"):
-    """Run a converting command (lines, trains, timetables: spec/<command> -> OUT): print the
-    findings of build(spec_dir) -> (outputs, report); on an error a summary line, nothing
-    written and exit status 1; else each output written as JSON to OUT/path_of(key), with
-    the line "<command>: describe(key, output, path)"."""
-    spec_dir, out_dir = Path(args.spec), Path(args.out)
-    outputs, report = build(spec_dir)
-    report.print()
-    if report.errors:
-        print(f"{command}: {len(report.errors)} error(s) in {spec_dir / command}; nothing written",
-              file=sys.stderr)
-        return 1
-    for key, obj in sorted(outputs.items()):
-        path = out_dir / path_of(key)
-        spec_mod.write_atomic(path, spec_mod.render_json(obj))
-        print(f"{command}: {describe(key, obj, path)}")
-    return 0
-
-
-def raise_first(report):
-    """Raise the report's first error as SpecError, with the count of the others."""
-    if report.errors:
-        first, more = report.errors[0], len(report.errors) - 1
-        raise SpecError(first.file, first.entry,
-                        first.reason + (f" (and {more} more)" if more else ""))
-
 
 def _check_file_name(report, f, data):
     if data["name"] != f.stem:
@@ -441,7 +156,7 @@ def _strings(obj, where=""):
 
 def _id_pattern(token):
     prefix = token.split("-", 1)[0]
-    return _PREFIX_KIND[prefix], {"REQ": REQ_ID, "HAZ": HAZ_ID, "ASM": ASM_ID, "UR": UR_ID}[prefix]
+    return PREFIX_KIND[prefix], {"REQ": REQ_ID, "HAZ": HAZ_ID, "ASM": ASM_ID, "UR": UR_ID}[prefix]
 
 
 def _list_files(spec_dir: Path, sub: str, report: Report):
@@ -466,7 +181,7 @@ def check_spec(spec_dir, data_files=()):
 
     for kind, (sub, key, schema_name, id_re) in KINDS.items():
         try:
-            validator = _load_schema(spec_dir, schema_name)
+            validator = load_schema(spec_dir, schema_name)
         except SpecError as exc:
             report.error(exc.file, exc.entry, exc.reason)
             continue
@@ -479,7 +194,7 @@ def check_spec(spec_dir, data_files=()):
             except SpecError as exc:
                 report.error(exc.file, exc.entry, exc.reason)
                 continue
-            _schema_errors(validator, data, f, report)
+            schema_errors(validator, data, f, report)
             if kind == "parameters":
                 _collect_parameters(f, data, model, param_areas, refs, report)
                 continue
@@ -510,18 +225,15 @@ def check_spec(spec_dir, data_files=()):
 
     # Line data (spec/lines, REQ-MB-020): schema and topology rules; the lines' assumption
     # and source strings join the cross-reference check below.
-    from . import lines as lines_mod  # imported here: lines builds on this module
     line_outputs, line_refs = lines_mod.check_lines(spec_dir, report)
     model["lines"] = line_outputs
     refs.extend(line_refs)
     # Train types (spec/trains, REQ-BR-010): schema, ranges and the pattern design rule.
-    from . import trains as trains_mod
     train_outputs, train_refs = trains_mod.check_trains(spec_dir, report)
     model["trains"] = {name: obj for (_m, name), obj in train_outputs.items()}
     refs.extend(train_refs)
     # Timetables (spec/timetables, REQ-LC-017) against those lines and train types; the
     # hand-written JSON data of the simulators (spec/scenarios, spec/wheelrail).
-    from . import timetables as timetables_mod
     model["timetables"], tt_refs = timetables_mod.check_timetables(
         spec_dir, report, model["lines"], model["trains"])
     refs.extend(tt_refs)
@@ -588,7 +300,7 @@ def _check_references(model, refs, report):
             if not pattern.match(token):
                 report.error(f, eid, f"{where}: malformed reference {token!r}")
             elif token not in model[kind]:
-                report.error(f, eid, f"{where}: unknown {_KIND_WORD[kind]} {token}")
+                report.error(f, eid, f"{where}: unknown {KIND_WORD[kind]} {token}")
 
 
 def _check_requirements(model, report):

@@ -47,7 +47,8 @@ from . import __version__, add_command
 from . import registry as registry_mod
 from . import spin as spin_mod
 from .errors import PipelineError, SpecError
-from .spec import load_yaml, write_atomic
+from .files import write_atomic
+from .spec import load_yaml
 
 REACHED, UNREACHABLE = "reached", "unreachable"
 KINDS = ("trap", "boundary", "random")

@@ -575,7 +575,7 @@ def test_each_capability_has_its_chapter_with_faults_and_plots(rendered):
         assert manifest[f"html/_images/{name}.svg"] == digest
         assert manifest[f"src/plots/{d}/{name}.svg"] == digest
         assert manifest[f"inputs/results/{d}/{name}.svg"] == digest
-    assert f'src="_images/d5_follow_20kmh.svg"' in _page(rendered, "mb")
+    assert 'src="_images/d5_follow_20kmh.svg"' in _page(rendered, "mb")
     assert "inputs/results/scenarios/d5_follow_20kmh.log.json" in manifest
     assert "inputs/spec/design/lc.md" in manifest and "inputs/source/models/tg.pml" in manifest
 

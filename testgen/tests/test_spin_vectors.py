@@ -13,7 +13,7 @@ import pytest
 
 from railproof_testgen import registry, spin, vectors
 from railproof_testgen.errors import PipelineError, SpecError
-from railproof_testgen.spec import write_atomic
+from railproof_testgen.files import write_atomic
 from railproof_testgen.vectors import Configuration
 from vector_results import check_vector_set, vector_set
 

@@ -184,7 +184,6 @@ def onboard_steps(ticks, b: dict, config):
     """Raw ONBOARD ticks -> vector steps (controllers' cycles, then the on-board cycle)."""
     t = timing(b, config)
     near = [2 * b["lc_a"], 2 * b["lc_b"]]
-    two = config == "TWO_TRAINS"
     ws = [0, 0]
     state = ["OPEN", "OPEN"]
     failure = ["NONE", "NONE"]

@@ -7,6 +7,7 @@ inputs verbatim and hashes what was written.
 from __future__ import annotations
 
 import hashlib
+import importlib
 import inspect
 import json
 import os
@@ -114,9 +115,9 @@ def copy_inputs(inp, inputs_dir: Path) -> list:
 def check_toolchain() -> None:
     """Fail early, in one line, when the documentation tool chain cannot work."""
     try:
-        import sphinx  # noqa: F401
+        for name in ("sphinx", "sphinxcontrib.test_reports"):  # installed and importable
+            importlib.import_module(name)
         import sphinx_needs.api
-        import sphinxcontrib.test_reports  # noqa: F401
     except ImportError as exc:
         raise PipelineError(f"the Sphinx tool chain is not installed ({exc.name}); install "
                             "testgen/requirements.txt into the Python environment") from None
