@@ -2,9 +2,7 @@
 #include "railproof/offline/line.hpp"
 
 #include <algorithm>
-#include <fstream>
 #include <set>
-#include <sstream>
 #include <string>
 #include <utility>
 
@@ -395,14 +393,9 @@ const RunningLine& Line::Running(std::string_view running_id) const {
 }
 
 Line ParseLine(std::string_view text, const std::string& file) {
-  const nlohmann::json doc = JsonNode::Parse(text, file);
-  const JsonNode root(doc, "", file);
+  const JsonDocument root(text, file, kLineSchema);
   Line line;
   line.file = file;
-  const JsonNode schema = root.Key("schema");
-  if (schema.String() != kLineSchema) {
-    schema.Fail("unsupported schema '" + schema.String() + "', expected '" + std::string(kLineSchema) + "'");
-  }
   line.name = root.Key("name").String();
   if (line.name.empty()) {
     root.Key("name").Fail("empty name");
@@ -412,27 +405,14 @@ Line ParseLine(std::string_view text, const std::string& file) {
   for (const auto& s : root.Key("source").Array()) {
     line.source.push_back(s.String());
   }
-  const JsonNode rls = root.Key("running_lines");
-  const auto nodes = rls.Array();
-  if (nodes.empty()) {
-    rls.Fail("no running line");
-  }
   std::set<std::string> ids;
-  for (const auto& n : nodes) {
+  for (const auto& n : root.Key("running_lines").NonEmptyArray("no running line")) {
     line.running_lines.push_back(ReadRunningLine(n, ids));
   }
   return line;
 }
 
-Line LoadLine(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    throw InputError(path.string() + ": cannot read line file");
-  }
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ParseLine(ss.str(), path.string());
-}
+Line LoadLine(const std::filesystem::path& path) { return ParseLine(ReadInputFile(path, "line file"), path.string()); }
 
 std::filesystem::path LinePath(const std::filesystem::path& lines_dir, std::string_view name) {
   return lines_dir / (std::string(name) + ".json");

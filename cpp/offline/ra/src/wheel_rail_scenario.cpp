@@ -8,7 +8,6 @@
 // step dividing the IMU period, fields that belong to one fault type).
 #include <algorithm>
 #include <cmath>
-#include <fstream>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -50,10 +49,7 @@ void ParseVertical(const JsonNode& n, WheelRailScenario& sc) {
     n.Key("end_m").Fail("must be at least 100 m beyond begin_m");
   }
   v.vertical_curve_radius_m = RangedKey(n, "vertical_curve_radius_m", 3000.0, 500.0, 100000.0);
-  const auto arr = n.Key("gradients").Array();
-  if (arr.empty()) {
-    n.Key("gradients").Fail("at least one gradient expected");
-  }
+  const auto arr = n.Key("gradients").NonEmptyArray("at least one gradient expected");
   for (const auto& e : arr) {
     GradientPoint g;
     g.from_m = e.Key("from_m").Number();
@@ -206,10 +202,7 @@ void ParseVehicle(const JsonNode& n, WheelRailScenario& sc) {
 }
 
 void ParseDriver(const JsonNode& n, WheelRailScenario& sc) {
-  const auto arr = n.Array();
-  if (arr.empty()) {
-    n.Fail("at least one driver command expected");
-  }
+  const auto arr = n.NonEmptyArray("at least one driver command expected");
   for (const auto& e : arr) {
     DriverCommand d;
     const auto tn = e.Key("t_s");
@@ -359,8 +352,7 @@ void ParseOdometry(const JsonNode& n, WheelRailScenario& sc) {
 }  // namespace
 
 WheelRailScenario ParseWheelRailScenario(std::string_view text, const std::string& file) {
-  const nlohmann::json doc = JsonNode::Parse(text, file);
-  const JsonNode root(doc, "", file);
+  const JsonDocument root(text, file);
   WheelRailScenario sc;
   sc.file = file;
   const auto schema = root.Key("schema");
@@ -456,13 +448,7 @@ WheelRailScenario ParseWheelRailScenario(std::string_view text, const std::strin
 }
 
 WheelRailScenario LoadWheelRailScenario(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    throw offline::InputError(path.string() + ": cannot read");
-  }
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ParseWheelRailScenario(ss.str(), path.string());
+  return ParseWheelRailScenario(offline::ReadInputFile(path, ""), path.string());
 }
 
 }  // namespace railproof::ra::analysis

@@ -10,7 +10,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <fstream>
 #include <limits>
 #include <set>
 #include <sstream>
@@ -183,14 +182,9 @@ FaultSpec ReadFault(const JsonNode& n, const std::string& entry) {
 }  // namespace
 
 Scenario ParseScenario(std::string_view text, const std::string& file) {
-  const nlohmann::json doc = JsonNode::Parse(text, file);
-  const JsonNode root(doc, "", file);
+  const JsonDocument root(text, file, kScenarioSchema);
   Scenario sc;
   sc.file = file;
-  const JsonNode schema = root.Key("schema");
-  if (schema.String() != kScenarioSchema) {
-    schema.Fail("unsupported schema '" + schema.String() + "', expected '" + std::string(kScenarioSchema) + "'");
-  }
   sc.name = root.Key("name").String();
   if (auto d = root.OptKey("description")) {
     sc.description = d->String();
@@ -278,13 +272,8 @@ Scenario ParseScenario(std::string_view text, const std::string& file) {
   }
 
   {
-    const JsonNode tn = root.Key("trains");
-    const auto nodes = tn.Array();
-    if (nodes.empty()) {
-      tn.Fail("no train");
-    }
     std::set<std::uint16_t> ids;
-    for (const auto& n : nodes) {
+    for (const auto& n : root.Key("trains").NonEmptyArray("no train")) {
       const TrainSpec base = ReadTrain(n, n.Path());
       std::int64_t count = 1;
       double interval_s = 0.0;
@@ -351,13 +340,7 @@ Scenario ParseScenario(std::string_view text, const std::string& file) {
 }
 
 Scenario LoadScenario(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    throw InputError(path.string() + ": cannot read scenario file");
-  }
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ParseScenario(ss.str(), path.string());
+  return ParseScenario(ReadInputFile(path, "scenario file"), path.string());
 }
 
 const RunningLine& SelectRunningLine(const Scenario& sc, const Line& line) {
