@@ -128,46 +128,44 @@ TrainSpec ReadTrain(const JsonNode& n, const std::string& entry) {
   return t;
 }
 
+FaultType ReadFaultType(const JsonNode& n) {
+  const std::string type = n.String();
+  for (const FaultType t : {FaultType::kRadioLoss, FaultType::kTrackingLoss, FaultType::kPossession,
+                            FaultType::kSidingRequest, FaultType::kSpeedRestriction}) {
+    if (type == ToString(t)) {
+      return t;
+    }
+  }
+  n.Fail("unknown fault type '" + type + "' (radio_loss, tracking_loss, possession, siding_request, speed_restriction)");
+}
+
 FaultSpec ReadFault(const JsonNode& n, const std::string& entry) {
   FaultSpec f;
   f.entry = entry;
-  const JsonNode tn = n.Key("type");
-  const std::string type = tn.String();
-  if (type == "radio_loss" || type == "tracking_loss") {
-    f.type = type == "radio_loss" ? FaultType::kRadioLoss : FaultType::kTrackingLoss;
+  f.type = ReadFaultType(n.Key("type"));
+  if (f.type == FaultType::kRadioLoss || f.type == FaultType::kTrackingLoss) {
     const JsonNode trn = n.Key("train");
     const std::int64_t id = trn.Int();
     if (id < 0 || id > 0xFFFF) {
       trn.Fail("train id out of range 0..65535");
     }
     f.train = static_cast<std::uint16_t>(id);
-  } else if (type == "possession") {
-    f.type = FaultType::kPossession;
+  } else if (f.type == FaultType::kPossession || f.type == FaultType::kSpeedRestriction) {
+    const bool possession = f.type == FaultType::kPossession;
     f.begin_mm = MetresToMm(NonNegative(n.Key("begin_m")));
     const JsonNode en = n.Key("end_m");
     f.end_mm = MetresToMm(NonNegative(en));
     if (f.end_mm <= f.begin_mm) {
-      en.Fail("possession end not after its begin");
+      en.Fail(std::string(possession ? "possession" : "restriction") + " end not after its begin");
     }
-  } else if (type == "speed_restriction") {
-    f.type = FaultType::kSpeedRestriction;
-    f.begin_mm = MetresToMm(NonNegative(n.Key("begin_m")));
-    const JsonNode en = n.Key("end_m");
-    f.end_mm = MetresToMm(NonNegative(en));
-    if (f.end_mm <= f.begin_mm) {
-      en.Fail("restriction end not after its begin");
+    if (!possession) {
+      f.speed_mps = Positive(n.Key("speed_kmh"), 400.0) / 3.6;
     }
-    f.speed_mps = Positive(n.Key("speed_kmh"), 400.0) / 3.6;
-  } else if (type == "siding_request") {
-    f.type = FaultType::kSidingRequest;
-    if (auto r = n.OptKey("route")) {
-      f.route = r->Int();
-      if (f.route <= 0) {
-        r->Fail("route id must be positive");
-      }
+  } else if (auto r = n.OptKey("route")) {  // a siding request naming its route
+    f.route = r->Int();
+    if (f.route <= 0) {
+      r->Fail("route id must be positive");
     }
-  } else {
-    tn.Fail("unknown fault type '" + type + "' (radio_loss, tracking_loss, possession, siding_request, speed_restriction)");
   }
   const JsonNode fn = n.Key("from_s");
   f.from_ms = SecondsToMs(fn, NonNegative(fn));
