@@ -21,6 +21,7 @@
 #include "railproof/offline/train_type.hpp"
 #include "railproof/offline/line.hpp"
 #include "railproof/testing/gen_data.hpp"
+#include "railproof/testing/input_error.hpp"
 
 namespace railproof::br::analysis {
 namespace {
@@ -41,16 +42,7 @@ std::string ReadAll(const std::filesystem::path& p) {
 nlohmann::json TrainJson() { return nlohmann::json::parse(ReadAll(GenDir() / "trains" / "emu3_d1.json")); }
 
 void ExpectRejected(const nlohmann::json& j, const std::vector<std::string>& fragments) {
-  try {
-    (void)ParseTrainType(j.dump(), "bad_train.json");
-    ADD_FAILURE() << "accepted: " << j.dump();
-  } catch (const offline::InputError& e) {
-    const std::string what = e.what();
-    EXPECT_EQ(what.rfind("bad_train.json: ", 0), 0U) << what;
-    for (const auto& f : fragments) {
-      EXPECT_NE(what.find(f), std::string::npos) << what << " lacks " << f;
-    }
-  }
+  testing::ExpectInputError([&] { (void)ParseTrainType(j.dump(), "bad_train.json"); }, "bad_train.json", fragments);
 }
 
 // @verifies REQ-BR-010
@@ -86,12 +78,8 @@ TEST(TrainType, RejectsBadJsonNamingFileEntryReason) {
   j = TrainJson();
   j["schema"] = "railproof/line-json/1";
   ExpectRejected(j, {"schema", "unsupported schema"});
-  try {
-    (void)LoadTrainType("/nonexistent/train.json");
-    ADD_FAILURE();
-  } catch (const offline::InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("/nonexistent/train.json: cannot read"), std::string::npos);
-  }
+  testing::ExpectInputError([] { (void)LoadTrainType("/nonexistent/train.json"); }, "/nonexistent/train.json",
+                            {"/nonexistent/train.json: cannot read"});
 }
 
 // @verifies REQ-BR-010

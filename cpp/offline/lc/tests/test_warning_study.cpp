@@ -5,9 +5,11 @@
 
 #include <map>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "railproof/testing/gen_data.hpp"
+#include "railproof/testing/input_error.hpp"
 #include "railproof/lc/analysis/warning_study.hpp"
 #include "railproof/generated/lc_params.hpp"
 
@@ -319,20 +321,16 @@ std::string Edit(const std::string& from, const std::string& to) {
   return t.replace(pos, from.size(), to);
 }
 
+// The timetable text read and checked against the three-station line: an InputError naming
+// tt.json in one line with every fragment.
 void ExpectTimetableError(const std::string& text, const std::vector<std::string>& fragments) {
-  try {
-    const Timetable tt = ParseTimetable(text, "tt.json");
-    const offline::Line line = MakeLine({{"A", 500'000}, {"M", 5'000'000}, {"B", 9'500'000}}, {});
-    CheckTimetable(tt, line, Trains());
-    ADD_FAILURE() << "no error for " << fragments.front();
-  } catch (const InputError& e) {
-    const std::string msg = e.what();
-    EXPECT_EQ(msg.rfind("tt.json: ", 0), 0U) << msg;
-    EXPECT_EQ(msg.find('\n'), std::string::npos) << msg;
-    for (const auto& f : fragments) {
-      EXPECT_NE(msg.find(f), std::string::npos) << "'" << f << "' not in: " << msg;
-    }
-  }
+  testing::ExpectInputError(
+      [&] {
+        const Timetable tt = ParseTimetable(text, "tt.json");
+        const offline::Line line = MakeLine({{"A", 500'000}, {"M", 5'000'000}, {"B", 9'500'000}}, {});
+        CheckTimetable(tt, line, Trains());
+      },
+      "tt.json", fragments);
 }
 
 TEST(WarningStudyTimetable, ReadsTheTimetableJson) {
@@ -369,36 +367,40 @@ TEST(WarningStudyTimetable, TheProvidedTimetableFitsItsLine) {
 // (type, range, min <= max), and the timetable must fit the line and train types given.
 // @verifies REQ-LC-017
 TEST(WarningStudyTimetable, ErrorsNameFileEntryAndReason) {
-  ExpectTimetableError(Edit("railproof/timetable-json/1", "railproof/timetable/1"),
-                       {"tt.json: schema: unsupported schema 'railproof/timetable/1'"});
-  ExpectTimetableError(Edit("\"seed\": 7", "\"seed\": 1e300"), {"tt.json: seed: expected an integer, got number"});
-  ExpectTimetableError(Edit("\"depart_ms\": 21600000", "\"depart_ms\": \"06:00\""),
-                       {"services[0] (1).depart_ms", "expected an integer, got string"});
-  ExpectTimetableError(Edit("\"depart_ms\": 21600000", "\"depart_ms\": -1"),
-                       {"services[0] (1).depart_ms", "-1 ms is outside [0, 172799999]"});
-  ExpectTimetableError(Edit("\"cruise_percent\": [85, 100]", "\"cruise_percent\": [100, 85]"),
-                       {"driver.cruise_percent", "min 100 % is greater than max 85 %"});
-  ExpectTimetableError(Edit("\"cruise_percent\": [85, 100]", "\"cruise_percent\": [0, 100]"),
-                       {"driver.cruise_percent[0]", "0 % is outside [50, 100]"});
-  ExpectTimetableError(Edit("\"onboard_cycle_ms\": 200", "\"onboard_cycle_ms\": 0"),
-                       {"communication.onboard_cycle_ms", "outside [1, 10000]"});
-  ExpectTimetableError(Edit("\"planned_time_step_ms\": 5000", "\"planned_time_step_ms\": 5000.5"),
-                       {"planned_time_step_ms", "expected an integer, got number"});
-  ExpectTimetableError(Edit("\"uplink_ms\": [200, 1500]", "\"uplink_ms\": [200]"),
-                       {"communication.uplink_ms", "expected [min, max], got 1 element(s)"});
-  ExpectTimetableError(Edit("\"seed\": 7,", "\"seed\": 7"), {"tt.json: invalid JSON"});
-  ExpectTimetableError(Edit("\"station\": \"M\"", "\"station\": \"Q\""),
-                       {"services[0] (1).stops[0]", "station 'Q' has no stop on running line up"});
-  ExpectTimetableError(Edit("\"station\": \"M\"", "\"station\": \"B\""),
-                       {"services[0] (1).stops[0]", "stop at B is not between the origin A and the destination B"});
-  ExpectTimetableError(Edit("\"train\": \"unit\", \"running_line\": \"up\", \"depart_ms\": 21600000",
-                            "\"train\": \"tram\", \"running_line\": \"up\", \"depart_ms\": 21600000"),
-                       {"services[0] (1).train", "unknown train type 'tram'"});
-  ExpectTimetableError(Edit("\"running_line\": \"up\", \"depart_ms\": 21600000",
-                            "\"running_line\": \"left\", \"depart_ms\": 21600000"),
-                       {"services[0] (1).running_line", "unknown running line 'left'"});
-  ExpectTimetableError(Edit("\"line\": \"test_line\"", "\"line\": \"d9_line\""),
-                       {"tt.json: line", "timetable for line 'd9_line'"});
+  // (text replaced, replacement, fragments of the message)
+  const std::vector<std::tuple<std::string, std::string, std::vector<std::string>>> edits{
+      {"railproof/timetable-json/1", "railproof/timetable/1",
+       {"tt.json: schema: unsupported schema 'railproof/timetable/1'"}},
+      {"\"seed\": 7", "\"seed\": 1e300", {"tt.json: seed: expected an integer, got number"}},
+      {"\"depart_ms\": 21600000", "\"depart_ms\": \"06:00\"",
+       {"services[0] (1).depart_ms", "expected an integer, got string"}},
+      {"\"depart_ms\": 21600000", "\"depart_ms\": -1",
+       {"services[0] (1).depart_ms", "-1 ms is outside [0, 172799999]"}},
+      {"\"cruise_percent\": [85, 100]", "\"cruise_percent\": [100, 85]",
+       {"driver.cruise_percent", "min 100 % is greater than max 85 %"}},
+      {"\"cruise_percent\": [85, 100]", "\"cruise_percent\": [0, 100]",
+       {"driver.cruise_percent[0]", "0 % is outside [50, 100]"}},
+      {"\"onboard_cycle_ms\": 200", "\"onboard_cycle_ms\": 0",
+       {"communication.onboard_cycle_ms", "outside [1, 10000]"}},
+      {"\"planned_time_step_ms\": 5000", "\"planned_time_step_ms\": 5000.5",
+       {"planned_time_step_ms", "expected an integer, got number"}},
+      {"\"uplink_ms\": [200, 1500]", "\"uplink_ms\": [200]",
+       {"communication.uplink_ms", "expected [min, max], got 1 element(s)"}},
+      {"\"seed\": 7,", "\"seed\": 7", {"tt.json: invalid JSON"}},
+      {"\"station\": \"M\"", "\"station\": \"Q\"",
+       {"services[0] (1).stops[0]", "station 'Q' has no stop on running line up"}},
+      {"\"station\": \"M\"", "\"station\": \"B\"",
+       {"services[0] (1).stops[0]", "stop at B is not between the origin A and the destination B"}},
+      {"\"train\": \"unit\", \"running_line\": \"up\", \"depart_ms\": 21600000",
+       "\"train\": \"tram\", \"running_line\": \"up\", \"depart_ms\": 21600000",
+       {"services[0] (1).train", "unknown train type 'tram'"}},
+      {"\"running_line\": \"up\", \"depart_ms\": 21600000", "\"running_line\": \"left\", \"depart_ms\": 21600000",
+       {"services[0] (1).running_line", "unknown running line 'left'"}},
+      {"\"line\": \"test_line\"", "\"line\": \"d9_line\"", {"tt.json: line", "timetable for line 'd9_line'"}},
+  };
+  for (const auto& [from, to, fragments] : edits) {
+    ExpectTimetableError(Edit(from, to), fragments);
+  }
 }
 
 // @verifies REQ-LC-017
