@@ -84,6 +84,21 @@ Service MakeService(std::vector<ServiceStop> stops) {
   return s;
 }
 
+// One service (S1, stopping at `stops`) over `line` under the test timetable and train type.
+struct OneService {
+  OneService(offline::Line l, std::vector<ServiceStop> stops)
+      : line(std::move(l)), tt(MakeTimetable({MakeService(std::move(stops))})) {}
+  // The study with the on-board methods' request lead `lead_ms` (-1: the project's).
+  [[nodiscard]] StudyResult Run(std::int64_t lead_ms = -1) const {
+    StudyInputs in{&line, &tt, &trains};
+    in.request_lead_ms = lead_ms;
+    return RunStudy(in);
+  }
+  offline::Line line;
+  Timetable tt;
+  std::map<std::string, TrainType> trains = Trains();
+};
+
 double W(const Passage& p, Method m) { return p.warning_ms[static_cast<std::size_t>(m)] / 1000.0; }
 
 // ---------------------------------------------------------------------------- treadles
@@ -166,12 +181,8 @@ TEST(WarningStudyRun, SectionAcceleratesCruisesAndBrakes) {
 // @verifies REQ-LC-008
 // @verifies REQ-LC-015
 TEST(WarningStudy, HandComputedWarningTimesOfASimpleRun) {
-  const offline::Line line = MakeLine({{"A", 500'000}, {"B", 9'500'000}}, {{"X", 5'000'000, 10'000, 30'000}});
-  const Timetable tt = MakeTimetable({MakeService({})});
-  const auto trains = Trains();
-  StudyInputs in{&line, &tt, &trains};
-  in.request_lead_ms = 6'000;
-  const StudyResult r = RunStudy(in);
+  const OneService one(MakeLine({{"A", 500'000}, {"B", 9'500'000}}, {{"X", 5'000'000, 10'000, 30'000}}), {});
+  const StudyResult r = one.Run(6'000);
   ASSERT_EQ(r.passages.size(), 1U);
   const Passage& p = r.passages[0];
   EXPECT_EQ(p.crossing, "X");
@@ -188,9 +199,7 @@ TEST(WarningStudy, HandComputedWarningTimesOfASimpleRun) {
   EXPECT_TRUE(p.braked[static_cast<std::size_t>(Method::kOnboardDwell)]);
   EXPECT_GT(p.arrival_ms - p.brake_at_ms[static_cast<std::size_t>(Method::kOnboardDwell)], 21'150.0);
   // a longer request lead: the confirmation comes before the pattern's first brake command
-  StudyInputs longer{&line, &tt, &trains};
-  longer.request_lead_ms = 15'000;
-  const StudyResult r15 = RunStudy(longer);
+  const StudyResult r15 = one.Run(15'000);
   const Passage& q = r15.passages.at(0);
   EXPECT_NEAR(W(q, Method::kOnboardDwell), 34.75 + 9.0, 0.002);
   for (Method m : {Method::kOnboard, Method::kOnboardDwell, Method::kOnboardApproach}) {
@@ -199,7 +208,7 @@ TEST(WarningStudy, HandComputedWarningTimesOfASimpleRun) {
   EXPECT_TRUE(StudyPasses(r15));
   // the project's request lead (spec/parameters/lc.yaml, chosen by the study's
   // sweep) avoids the braking here too
-  const StudyResult rp = RunStudy({&line, &tt, &trains});
+  const StudyResult rp = one.Run();
   EXPECT_FALSE(rp.passages.at(0).braked[static_cast<std::size_t>(Method::kOnboardDwell)]);
   EXPECT_NEAR(W(rp.passages.at(0), Method::kOnboardDwell), 34.75 + (lcp::request_lead_ms - 6'000) / 1000.0, 0.25);
 }
@@ -212,13 +221,10 @@ TEST(WarningStudy, HandComputedWarningTimesOfASimpleRun) {
 // @verifies REQ-LC-005
 // @verifies REQ-LC-017
 TEST(WarningStudy, DwellAwarenessAgainstNone) {
-  const offline::Line line =
-      MakeLine({{"A", 500'000}, {"M", 5'000'000}, {"B", 9'500'000}}, {{"X", 5'100'000, 10'000, 30'000}});
-  const Timetable tt = MakeTimetable({MakeService({{"M", 60'000}})});
-  const auto trains = Trains();
-  StudyInputs in{&line, &tt, &trains};
-  in.request_lead_ms = 15'000;  // long enough for the confirmation to come before the pattern
-  const StudyResult r = RunStudy(in);
+  const OneService one(
+      MakeLine({{"A", 500'000}, {"M", 5'000'000}, {"B", 9'500'000}}, {{"X", 5'100'000, 10'000, 30'000}}),
+      {{"M", 60'000}});
+  const StudyResult r = one.Run(15'000);  // long enough for the confirmation to come before the pattern
   ASSERT_EQ(r.passages.size(), 1U);
   const Passage& p = r.passages[0];
   EXPECT_TRUE(p.stop_in_approach);
@@ -245,12 +251,8 @@ TEST(WarningStudy, DwellAwarenessAgainstNone) {
 // before the departure-based arrival.
 // @verifies REQ-LC-005
 TEST(WarningStudy, DwellAwareAtTheOrigin) {
-  const offline::Line line = MakeLine({{"A", 500'000}, {"B", 9'500'000}}, {{"X", 805'000, 10'000, 30'000}});
-  const Timetable tt = MakeTimetable({MakeService({})});
-  const auto trains = Trains();
-  StudyInputs in{&line, &tt, &trains};
-  in.request_lead_ms = 6'000;
-  const StudyResult r = RunStudy(in);
+  const OneService one(MakeLine({{"A", 500'000}, {"B", 9'500'000}}, {{"X", 805'000, 10'000, 30'000}}), {});
+  const StudyResult r = one.Run(6'000);
   ASSERT_EQ(r.passages.size(), 1U);
   const Passage& p = r.passages[0];
   // from rest: 200 m in 20 s, 100 m at 20 m/s in 5 s -> 25 s to the near edge
@@ -267,11 +269,9 @@ TEST(WarningStudy, DwellAwareAtTheOrigin) {
 // pattern's first brake command, the train would have braked (REQ-LC-015 counts it).
 // @verifies REQ-LC-015
 TEST(WarningStudy, LateConfirmationIsCountedAsBraking) {
-  const offline::Line line = MakeLine({{"A", 500'000}, {"B", 9'500'000}}, {{"X", 5'000'000, 10'000, 30'000}});
-  Timetable tt = MakeTimetable({MakeService({})});
-  tt.comms.barrier_travel_ms = {20'000, 20'000};
-  const auto trains = Trains();
-  const StudyResult r = RunStudy({&line, &tt, &trains});
+  OneService one(MakeLine({{"A", 500'000}, {"B", 9'500'000}}, {{"X", 5'000'000, 10'000, 30'000}}), {});
+  one.tt.comms.barrier_travel_ms = {20'000, 20'000};
+  const StudyResult r = one.Run();
   ASSERT_EQ(r.passages.size(), 1U);
   EXPECT_TRUE(r.passages[0].braked[static_cast<std::size_t>(Method::kOnboardDwell)]);
   EXPECT_FALSE(StudyPasses(r));
