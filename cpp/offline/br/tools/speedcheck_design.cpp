@@ -363,7 +363,7 @@ int Main(int argc, char** argv) {
                   worst_dev, worst_at);
     notes.push_back(note);
     j["notes"] = notes;
-    railproof::offline::WriteFileAtomic(o.json_path, j.dump(1) + "\n");
+    railproof::offline::WriteJsonFile(o.json_path, j);
   }
   if (!o.svg_path.empty()) {
     railproof::offline::WriteFileAtomic(o.svg_path, RenderSvg(d, fixed, 10.0 * an::AsymptoteN1F(in)));

@@ -525,8 +525,7 @@ int Main(int argc, char** argv) {
         studies[i] = an::StudyScenario(sc);
         const an::ScenarioStudy& st = *studies[i];
         railproof::offline::WriteFileAtomic(fs::path(o.out_dir) / (sc.name + ".svg"), an::ScenarioPlotSvg(st));
-        railproof::offline::WriteFileAtomic(fs::path(o.out_dir) / (sc.name + ".events.json"),
-                                        EventsFileJson(st).dump(1) + "\n");
+        railproof::offline::WriteJsonFile(fs::path(o.out_dir) / (sc.name + ".events.json"), EventsFileJson(st));
         if (!o.cycles_dir.empty()) {
           for (const an::StudyRun* r : {&st.primary, &st.single, &st.baseline}) {
             railproof::offline::WriteFileAtomic(fs::path(o.cycles_dir) / (sc.name + "." + r->label + ".csv"),
@@ -744,7 +743,7 @@ int Main(int argc, char** argv) {
          "length",
          "baseline extension (margin_table): the former method's occupied-range growth with the rear bound still "
          "moving (worst case); compare with imu_extension (front + rear margin, permanent)"});
-    railproof::offline::WriteFileAtomic(o.json, j.dump(1) + "\n");
+    railproof::offline::WriteJsonFile(o.json, j);
   }
 
   // ---- summary

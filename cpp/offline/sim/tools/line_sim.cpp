@@ -142,7 +142,7 @@ int Main(int argc, char** argv) {
              {"result", all_pass ? "PASS" : "FAIL"}};
     std::printf("gap grows with the leader's speed: %s\n", grows ? "yes" : "no");
     if (!o.summary.empty()) {
-      railproof::offline::WriteFileAtomic(o.summary, out.dump(1) + "\n");
+      railproof::offline::WriteJsonFile(o.summary, out);
     }
     return all_pass ? 0 : 1;
   }
@@ -177,7 +177,7 @@ int Main(int argc, char** argv) {
   }
   const Json s = sim.Summary();
   if (!o.summary.empty()) {
-    railproof::offline::WriteFileAtomic(o.summary, s.dump(1) + "\n");
+    railproof::offline::WriteJsonFile(o.summary, s);
   }
   if (!o.svg.empty()) {
     railproof::offline::WriteFileAtomic(o.svg, sim.Svg());
