@@ -208,11 +208,7 @@ std::string Svg(const Job& job, const std::map<int, std::size_t>& worst_by_class
 int Main(int argc, char** argv) {
   const Options o = ParseArgs(argc, argv);
   const auto t_start = std::chrono::steady_clock::now();
-  auto progress = [&](const std::string& s) {
-    if (!o.quiet) {
-      std::fprintf(stderr, "margins: %s\n", s.c_str());
-    }
-  };
+  const railproof::offline::Progress progress("margins", o.quiet);
   std::vector<railproof::offline::Line> lines;
   for (const auto& f : o.lines) {
     lines.push_back(railproof::offline::LoadLine(f));

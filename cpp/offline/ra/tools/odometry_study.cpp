@@ -22,7 +22,6 @@
 #include <exception>
 #include <filesystem>
 #include <map>
-#include <mutex>
 #include <optional>
 #include <string>
 #include <thread>
@@ -465,13 +464,7 @@ std::string Fmt(const char* f, double v) {
 int Main(int argc, char** argv) {
   const Options o = ParseArgs(argc, argv);
   const auto t0 = std::chrono::steady_clock::now();
-  std::mutex log_mu;
-  const auto progress = [&](const std::string& s) {
-    if (!o.quiet) {
-      const std::lock_guard<std::mutex> lock(log_mu);
-      std::fprintf(stderr, "odometry_study: %s\n", s.c_str());
-    }
-  };
+  const railproof::offline::Progress progress("odometry_study", o.quiet);
 
   // ---- inputs
   std::vector<fs::path> files = ListJson(o.scenarios, "wheel-rail scenarios");
