@@ -40,6 +40,7 @@
 #include <limits>
 #include <mutex>
 #include <stdexcept>
+#include <utility>
 #include <vector>
 
 #include "railproof/br/analysis/margins.hpp"
@@ -59,6 +60,17 @@ double Sigmoid(double u) {
   return e / (1.0 + e);
 }
 double Softplus(double u) { return std::max(u, 0.0) + std::log1p(std::exp(-std::abs(u))); }
+
+// `iterations` bisection steps on [lo, hi] towards the boundary of `below` (true at lo, false
+// at hi); the final bracket.
+template <typename Below>
+std::pair<double, double> Bisect(double lo, double hi, int iterations, const Below& below) {
+  for (int i = 0; i < iterations; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (below(mid) ? lo : hi) = mid;
+  }
+  return {lo, hi};
+}
 
 // A piecewise-constant function with logistic steps of width eps: level + sum over k of
 // change[k] * Sigmoid((x - at[k]) / eps).
@@ -129,16 +141,10 @@ struct ContModel {
     if (!ok(v_floor)) {
       return -1.0;
     }
-    double lo = v_floor;
-    double hi = vtrain;
-    if (ok(hi)) {
-      return hi;
+    if (ok(vtrain)) {
+      return vtrain;
     }
-    for (int i = 0; i < 60; ++i) {
-      const double mid = 0.5 * (lo + hi);
-      (ok(mid) ? lo : hi) = mid;
-    }
-    return lo;
+    return Bisect(v_floor, vtrain, 60, ok).first;
   }
 };
 
@@ -203,11 +209,8 @@ ContTraj ContEvaluate(const ContModel& c, const ContParams& p, int n, int mb) {
     // cannot happen with positive run-up speeds; widen once
     hi = tr.x0 + 4.0 * (hi - tr.x0);
   }
-  for (int i = 0; i < 80; ++i) {
-    const double mid = 0.5 * (lo + hi);
-    (time_to(mid, nullptr, nullptr) < tr_total ? lo : hi) = mid;
-  }
-  tr.x1 = 0.5 * (lo + hi);
+  const auto [x_lo, x_hi] = Bisect(lo, hi, 80, [&](double x) { return time_to(x, nullptr, nullptr) < tr_total; });
+  tr.x1 = 0.5 * (x_lo + x_hi);
   time_to(tr.x1, &tr.w, &tr.t);
   const double wn = tr.w.back();
   const double ig1 = c.IG(tr.x1);
