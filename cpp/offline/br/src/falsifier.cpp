@@ -11,11 +11,13 @@
 #include <ompl/util/RandomNumbers.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <limits>
 #include <memory>
 #include <mutex>
+#include <utility>
 
 #include "railproof/br/supervisor.hpp"
 #include "railproof/offline/dynamics.hpp"
@@ -139,41 +141,42 @@ class AdversarialControlSampler : public oc::ControlSampler {
   std::vector<double> worst_;
 };
 
+// The adversary's controls, in the order of the control vector: the key of each in a
+// regression case and its member of AdversaryStep.
+constexpr std::array<std::pair<const char*, double AdversaryStep::*>, kControlDims> kControls{{
+    {"traction", &AdversaryStep::traction},
+    {"speed_error", &AdversaryStep::speed_error},
+    {"beta_mm_s2", &AdversaryStep::beta_mm_s2},
+    {"free_running_ms", &AdversaryStep::free_running_ms},
+    {"gradient_error_x10", &AdversaryStep::gradient_error_x10},
+    {"position_error_mm", &AdversaryStep::position_error_mm},
+    {"stale_mm", &AdversaryStep::stale_mm},
+}};
+
 AdversaryStep FromControl(const oc::Control* ctl) {
   const double* u = ctl->as<oc::RealVectorControlSpace::ControlType>()->values;
   AdversaryStep c;
-  c.traction = u[0];
-  c.speed_error = u[1];
-  c.beta_mm_s2 = u[2];
-  c.free_running_ms = u[3];
-  c.gradient_error_x10 = u[4];
-  c.position_error_mm = u[5];
-  c.stale_mm = u[6];
+  for (std::size_t i = 0; i < kControls.size(); ++i) {
+    c.*kControls[i].second = u[i];
+  }
   return c;
 }
 
 nlohmann::ordered_json StepJson(const AdversaryStep& c) {
-  return {{"cycles", c.cycles},
-          {"traction", c.traction},
-          {"speed_error", c.speed_error},
-          {"beta_mm_s2", c.beta_mm_s2},
-          {"free_running_ms", c.free_running_ms},
-          {"gradient_error_x10", c.gradient_error_x10},
-          {"position_error_mm", c.position_error_mm},
-          {"stale_mm", c.stale_mm}};
+  nlohmann::ordered_json j{{"cycles", c.cycles}};
+  for (const auto& [key, member] : kControls) {
+    j[key] = c.*member;
+  }
+  return j;
 }
 
 // The step of a regression case (the inverse of StepJson).
 AdversaryStep StepFromJson(const offline::JsonNode& st) {
   AdversaryStep c;
   c.cycles = static_cast<int>(st.Key("cycles").Int());
-  c.traction = st.Key("traction").Number();
-  c.speed_error = st.Key("speed_error").Number();
-  c.beta_mm_s2 = st.Key("beta_mm_s2").Number();
-  c.free_running_ms = st.Key("free_running_ms").Number();
-  c.gradient_error_x10 = st.Key("gradient_error_x10").Number();
-  c.position_error_mm = st.Key("position_error_mm").Number();
-  c.stale_mm = st.Key("stale_mm").Number();
+  for (const auto& [key, member] : kControls) {
+    c.*member = st.Key(key).Number();
+  }
   return c;
 }
 

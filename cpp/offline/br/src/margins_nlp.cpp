@@ -40,6 +40,7 @@
 #include <limits>
 #include <mutex>
 #include <stdexcept>
+#include <utility>
 #include <vector>
 
 #include "railproof/br/analysis/margins.hpp"
@@ -60,64 +61,63 @@ double Sigmoid(double u) {
 }
 double Softplus(double u) { return std::max(u, 0.0) + std::log1p(std::exp(-std::abs(u))); }
 
+// `iterations` bisection steps on [lo, hi] towards the boundary of `below` (true at lo, false
+// at hi); the final bracket.
+template <typename Below>
+std::pair<double, double> Bisect(double lo, double hi, int iterations, const Below& below) {
+  for (int i = 0; i < iterations; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (below(mid) ? lo : hi) = mid;
+  }
+  return {lo, hi};
+}
+
+// A piecewise-constant function with logistic steps of width eps: level + sum over k of
+// change[k] * Sigmoid((x - at[k]) / eps).
+struct SmoothSteps {
+  double level = 0.0;
+  std::vector<double> at, change;
+
+  // The function (order 0) or its first or second derivative (order 1, 2) at x.
+  [[nodiscard]] double Value(double x, double eps, int order) const {
+    double s = order == 0 ? level : 0.0;
+    for (std::size_t k = 0; k < at.size(); ++k) {
+      const double q = Sigmoid((x - at[k]) / eps);
+      if (order == 0) {
+        s += change[k] * q;
+      } else if (order == 1) {
+        s += change[k] * q * (1.0 - q) / eps;
+      } else {
+        s += change[k] * q * (1.0 - q) * (1.0 - 2.0 * q) / (eps * eps);
+      }
+    }
+    return s;
+  }
+};
+
 // Continuous model of one location.
 struct ContModel {
   double eps = 0.2;
   double xref = 0.0;
-  double g0 = 0.0;
-  std::vector<double> gp, gd;  // gradient steps (position m, change as a fraction)
-  double c0 = 0.0;
-  std::vector<double> cp, cd;  // ceiling steps (position m, change m/s), already shifted
+  SmoothSteps gradient;  // gradient steps (position m, change as a fraction)
+  SmoothSteps ceiling;   // ceiling steps (position m, change m/s), already shifted
   double grav = 9.807, am = 0.0, ap = 0.0, tp = 0.0, beta_e = 0.0, ge = 0.0;
   double kk = 1.0, abs0 = 0.0, sc0 = 0.0, sc1 = 0.0, vtrain = 0.0, e_max = 0.0, d = 0.0;
   double react = 0.0, cycle = 0.0, beta_lo = 0.0, beta_hi = 0.0, tf_lo = 0.0, tf_hi = 0.0;
   double v_floor = 0.01;
 
-  [[nodiscard]] double G(double x) const {
-    double s = g0;
-    for (std::size_t k = 0; k < gp.size(); ++k) {
-      s += gd[k] * Sigmoid((x - gp[k]) / eps);
-    }
-    return s;
-  }
-  [[nodiscard]] double DG(double x) const {
-    double s = 0.0;
-    for (std::size_t k = 0; k < gp.size(); ++k) {
-      const double q = Sigmoid((x - gp[k]) / eps);
-      s += gd[k] * q * (1.0 - q) / eps;
-    }
-    return s;
-  }
+  [[nodiscard]] double G(double x) const { return gradient.Value(x, eps, 0); }
+  [[nodiscard]] double DG(double x) const { return gradient.Value(x, eps, 1); }
   [[nodiscard]] double IG(double x) const {
-    double s = g0 * (x - xref);
-    for (std::size_t k = 0; k < gp.size(); ++k) {
-      s += gd[k] * eps * Softplus((x - gp[k]) / eps);
+    double s = gradient.level * (x - xref);
+    for (std::size_t k = 0; k < gradient.at.size(); ++k) {
+      s += gradient.change[k] * eps * Softplus((x - gradient.at[k]) / eps);
     }
     return s;
   }
-  [[nodiscard]] double C(double y) const {
-    double s = c0;
-    for (std::size_t k = 0; k < cp.size(); ++k) {
-      s += cd[k] * Sigmoid((y - cp[k]) / eps);
-    }
-    return s;
-  }
-  [[nodiscard]] double DC(double y) const {
-    double s = 0.0;
-    for (std::size_t k = 0; k < cp.size(); ++k) {
-      const double q = Sigmoid((y - cp[k]) / eps);
-      s += cd[k] * q * (1.0 - q) / eps;
-    }
-    return s;
-  }
-  [[nodiscard]] double DDC(double y) const {
-    double s = 0.0;
-    for (std::size_t k = 0; k < cp.size(); ++k) {
-      const double q = Sigmoid((y - cp[k]) / eps);
-      s += cd[k] * q * (1.0 - q) * (1.0 - 2.0 * q) / (eps * eps);
-    }
-    return s;
-  }
+  [[nodiscard]] double C(double y) const { return ceiling.Value(y, eps, 0); }
+  [[nodiscard]] double DC(double y) const { return ceiling.Value(y, eps, 1); }
+  [[nodiscard]] double DDC(double y) const { return ceiling.Value(y, eps, 2); }
   // W(y) of the continuous emergency pattern and its derivatives.
   [[nodiscard]] double W(double y) const {
     return -2.0 * (beta_e - grav * ge) * y + 2.0 * grav * (IG(0.0) - IG(y));
@@ -141,16 +141,10 @@ struct ContModel {
     if (!ok(v_floor)) {
       return -1.0;
     }
-    double lo = v_floor;
-    double hi = vtrain;
-    if (ok(hi)) {
-      return hi;
+    if (ok(vtrain)) {
+      return vtrain;
     }
-    for (int i = 0; i < 60; ++i) {
-      const double mid = 0.5 * (lo + hi);
-      (ok(mid) ? lo : hi) = mid;
-    }
-    return lo;
+    return Bisect(v_floor, vtrain, 60, ok).first;
   }
 };
 
@@ -215,11 +209,8 @@ ContTraj ContEvaluate(const ContModel& c, const ContParams& p, int n, int mb) {
     // cannot happen with positive run-up speeds; widen once
     hi = tr.x0 + 4.0 * (hi - tr.x0);
   }
-  for (int i = 0; i < 80; ++i) {
-    const double mid = 0.5 * (lo + hi);
-    (time_to(mid, nullptr, nullptr) < tr_total ? lo : hi) = mid;
-  }
-  tr.x1 = 0.5 * (lo + hi);
+  const auto [x_lo, x_hi] = Bisect(lo, hi, 80, [&](double x) { return time_to(x, nullptr, nullptr) < tr_total; });
+  tr.x1 = 0.5 * (x_lo + x_hi);
   time_to(tr.x1, &tr.w, &tr.t);
   const double wn = tr.w.back();
   const double ig1 = c.IG(tr.x1);
@@ -351,11 +342,7 @@ class MarginTnlp : public Ipopt::TNLP {
   }
   bool eval_jac_g(Index, const Number* x, bool, Index, Index nele, Index* irow, Index* jcol, Number* values) override {
     if (values == nullptr) {
-      for (Index k = 0; k < nele; ++k) {
-        irow[k] = jr_[static_cast<std::size_t>(k)];
-        jcol[k] = jc_[static_cast<std::size_t>(k)];
-      }
-      return true;
+      return CopyStructure(jr_, jc_, nele, irow, jcol);
     }
     Acc acc{Mode::kJac, nullptr, values, nullptr, nullptr, 0};
     Eval(x, acc);
@@ -364,11 +351,7 @@ class MarginTnlp : public Ipopt::TNLP {
   bool eval_h(Index, const Number* x, bool, Number, Index, const Number* lambda, bool, Index nele, Index* irow,
               Index* jcol, Number* values) override {
     if (values == nullptr) {
-      for (Index k = 0; k < nele; ++k) {
-        irow[k] = hr_[static_cast<std::size_t>(k)];
-        jcol[k] = hc_[static_cast<std::size_t>(k)];
-      }
-      return true;
+      return CopyStructure(hr_, hc_, nele, irow, jcol);
     }
     Acc acc{Mode::kHess, nullptr, nullptr, values, lambda, 0};
     Eval(x, acc);
@@ -391,6 +374,17 @@ class MarginTnlp : public Ipopt::TNLP {
     const Number* lambda;
     std::size_t k;  // running index of jac / hess entries
   };
+
+  // The first nele entries of a structure (the rows and columns of the Jacobian or Hessian
+  // entries) for Ipopt.
+  static bool CopyStructure(const std::vector<Index>& rows, const std::vector<Index>& cols, Index nele, Index* irow,
+                            Index* jcol) {
+    for (Index k = 0; k < nele; ++k) {
+      irow[k] = rows[static_cast<std::size_t>(k)];
+      jcol[k] = cols[static_cast<std::size_t>(k)];
+    }
+    return true;
+  }
 
   // Structure: every Jac / Hess add call is one triplet entry, in a fixed order (Ipopt sums
   // duplicate entries), independent of the values.
@@ -611,15 +605,15 @@ ContModel MakeContModel(const MarginModel& m, const Location& loc, const NlpOpti
   // gradient steps in [lo, hi]
   const auto& ps = m.piece_start();
   const auto& pg = m.piece_gradient();
-  c.g0 = static_cast<double>(pg[0]) / 10000.0;
+  c.gradient.level = static_cast<double>(pg[0]) / 10000.0;
   for (std::size_t k = 1; k < ps.size(); ++k) {
     const double p = (ps[k] - l) / 1000.0;
     const double dlt = static_cast<double>(pg[k] - pg[k - 1]) / 10000.0;
     if (p < lo) {
-      c.g0 += dlt;  // fully passed: absorbed in the level (IG's constant is irrelevant)
+      c.gradient.level += dlt;  // fully passed: absorbed in the level (IG's constant is irrelevant)
     } else if (p <= hi) {
-      c.gp.push_back(p);
-      c.gd.push_back(dlt);
+      c.gradient.at.push_back(p);
+      c.gradient.change.push_back(dlt);
     }
   }
   // ceiling steps (sampled from the runtime's ceiling semantics at its breakpoints)
@@ -630,8 +624,8 @@ ContModel MakeContModel(const MarginModel& m, const Location& loc, const NlpOpti
     cuts.push_back(static_cast<double>(s.section.end_mm) + ext);
   }
   std::sort(cuts.begin(), cuts.end());
-  c.c0 = m.EmergencyCeilingMmS(l + lo * 1000.0) / 1000.0;
-  double prev = c.c0;
+  c.ceiling.level = m.EmergencyCeilingMmS(l + lo * 1000.0) / 1000.0;
+  double prev = c.ceiling.level;
   for (const double cut : cuts) {
     const double p = (cut - l) / 1000.0;
     if (p <= lo || p > hi) {
@@ -640,8 +634,8 @@ ContModel MakeContModel(const MarginModel& m, const Location& loc, const NlpOpti
     const double v = m.EmergencyCeilingMmS(cut) / 1000.0;
     if (v != prev) {
       // rise: start early; drop: finish late (smoothed ceiling >= exact ceiling)
-      c.cp.push_back(v > prev ? p - 4.0 * c.eps : p + 4.0 * c.eps);
-      c.cd.push_back(v - prev);
+      c.ceiling.at.push_back(v > prev ? p - 4.0 * c.eps : p + 4.0 * c.eps);
+      c.ceiling.change.push_back(v - prev);
       prev = v;
     }
   }

@@ -15,25 +15,28 @@
 #include "railproof/offline/line.hpp"
 #include "railproof/testing/gen_data.hpp"
 
+#include "d1_margin_case.hpp"
+
 namespace railproof::br::analysis {
 namespace {
 
-using testing::GenDir;
 using testing::Train;
 std::filesystem::path DataDir() { return std::filesystem::path(__FILE__).parent_path() / "data"; }
 
-
-const Location kEndOfTrack{LocationClass::kEndOfTrack, "end of track", 14'500'000, 10'000, 14'490'000};
+// The falsifier at the end of track of D1's up line for `train`, seed 1, within `budget_s`,
+// over the moving states only (a standing restart is not searched).
+FalsifierResult FalsifyMovingAtEndOfTrack(const std::string& train, double budget_s) {
+  const D1UpModel d1(train);
+  FalsifierOptions o;
+  o.budget_s = budget_s;
+  o.seed = 1;
+  o.admit_standstill_restart = false;
+  return Falsify(d1.model, kD1EndOfTrack, d1.line.name, o);
+}
 
 // @verifies REQ-BR-009 REQ-BR-014
 TEST(Falsifier, FindsAViolationForTheWeakenedTrain) {
-  const offline::Line line = offline::LoadLine(GenDir() / "lines" / "d1_test_line.json");
-  const MarginModel m(line.Running("up"), Train("emu3_d1_weak"), ReferenceSpeedErrorModel());
-  FalsifierOptions o;
-  o.budget_s = 2.0;
-  o.seed = 1;
-  o.admit_standstill_restart = false;  // the weak brake alone must be found
-  const FalsifierResult r = Falsify(m, kEndOfTrack, line.name, o);
+  const FalsifierResult r = FalsifyMovingAtEndOfTrack("emu3_d1_weak", 2.0);  // the weak brake alone must be found
   ASSERT_TRUE(r.violation);
   EXPECT_GT(r.max_overrun_mm, 1000.0);
   // the case replays as unsafe for the weak train
@@ -43,13 +46,7 @@ TEST(Falsifier, FindsAViolationForTheWeakenedTrain) {
 
 // @verifies REQ-BR-009 REQ-BR-014
 TEST(Falsifier, FindsNoViolationForACorrectTrainInItsMovingStates) {
-  const offline::Line line = offline::LoadLine(GenDir() / "lines" / "d1_test_line.json");
-  const MarginModel m(line.Running("up"), Train("emu3_d1"), ReferenceSpeedErrorModel());
-  FalsifierOptions o;
-  o.budget_s = 1.0;
-  o.seed = 1;
-  o.admit_standstill_restart = false;
-  const FalsifierResult r = Falsify(m, kEndOfTrack, line.name, o);
+  const FalsifierResult r = FalsifyMovingAtEndOfTrack("emu3_d1", 1.0);
   EXPECT_FALSE(r.violation);
   EXPECT_LT(r.max_overrun_mm, 0.0);
   EXPECT_GT(r.propagations, 1000U);

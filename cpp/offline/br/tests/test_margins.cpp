@@ -21,14 +21,15 @@
 #include "railproof/offline/train_type.hpp"
 #include "railproof/offline/line.hpp"
 #include "railproof/testing/gen_data.hpp"
+#include "railproof/testing/input_error.hpp"
+
+#include "d1_margin_case.hpp"
 
 namespace railproof::br::analysis {
 namespace {
 
 using testing::GenDir;
 using testing::Train;
-
-offline::Line D1() { return offline::LoadLine(GenDir() / "lines" / "d1_test_line.json"); }
 
 std::string ReadAll(const std::filesystem::path& p) {
   std::ifstream in(p);
@@ -41,16 +42,7 @@ std::string ReadAll(const std::filesystem::path& p) {
 nlohmann::json TrainJson() { return nlohmann::json::parse(ReadAll(GenDir() / "trains" / "emu3_d1.json")); }
 
 void ExpectRejected(const nlohmann::json& j, const std::vector<std::string>& fragments) {
-  try {
-    (void)ParseTrainType(j.dump(), "bad_train.json");
-    ADD_FAILURE() << "accepted: " << j.dump();
-  } catch (const offline::InputError& e) {
-    const std::string what = e.what();
-    EXPECT_EQ(what.rfind("bad_train.json: ", 0), 0U) << what;
-    for (const auto& f : fragments) {
-      EXPECT_NE(what.find(f), std::string::npos) << what << " lacks " << f;
-    }
-  }
+  testing::ExpectInputError([&] { (void)ParseTrainType(j.dump(), "bad_train.json"); }, "bad_train.json", fragments);
 }
 
 // @verifies REQ-BR-010
@@ -86,12 +78,8 @@ TEST(TrainType, RejectsBadJsonNamingFileEntryReason) {
   j = TrainJson();
   j["schema"] = "railproof/line-json/1";
   ExpectRejected(j, {"schema", "unsupported schema"});
-  try {
-    (void)LoadTrainType("/nonexistent/train.json");
-    ADD_FAILURE();
-  } catch (const offline::InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("/nonexistent/train.json: cannot read"), std::string::npos);
-  }
+  testing::ExpectInputError([] { (void)LoadTrainType("/nonexistent/train.json"); }, "/nonexistent/train.json",
+                            {"/nonexistent/train.json: cannot read"});
 }
 
 // @verifies REQ-BR-010
@@ -173,9 +161,8 @@ TEST(Margins, FlatLineClosedFormMatchesGridAndNlp) {
 
 // @verifies REQ-BR-009 REQ-BR-014
 TEST(Margins, IpoptDerivativeCheckerReportsNoErrors) {
-  const offline::Line line = D1();
-  const TrainType t = Train("emu3_d1");
-  const MarginModel m(line.Running("up"), t, ReferenceSpeedErrorModel());
+  const D1UpModel d1("emu3_d1");
+  const MarginModel& m = d1.model;
   // a location whose approach crosses gradient and ceiling steps
   const Location loc{LocationClass::kPossession, "test", 3'250'000, 50'000, 3'200'000};
   const auto file = std::filesystem::temp_directory_path() / "railproof_margins_derivative_test.txt";
@@ -245,10 +232,9 @@ TEST(Margins, RealTrainTypesHaveNonNegativeMovingMarginsOnALineSection) {
 // except those of the platform stop and the level crossing (class margin 0).
 // @verifies REQ-BR-009 REQ-BR-014
 TEST(Margins, StandstillRestartWhereThePatternIsZeroIsReported) {
-  const offline::Line line = D1();
-  const TrainType t = Train("emu3_d1");
-  const MarginModel m(line.Running("up"), t, ReferenceSpeedErrorModel());
-  const Location loc{LocationClass::kEndOfTrack, "end of track", 14'500'000, 10'000, 14'490'000};
+  const D1UpModel d1("emu3_d1");
+  const MarginModel& m = d1.model;
+  const Location& loc = kD1EndOfTrack;
   const GridResult g = GridWorstCase(m, loc, 1000);
   EXPECT_GE(g.moving_margin_mm, 0.0);
   if (m.patterns().EmergencyPatternSpeed(loc.stop_limit_mm, loc.stop_limit_mm, m.position_error_mm(),
@@ -262,11 +248,7 @@ TEST(Margins, StandstillRestartWhereThePatternIsZeroIsReported) {
 
 // @verifies REQ-BR-009 REQ-BR-010
 TEST(Margins, WeakenedTrainTypeGivesNegativeMargins) {
-  const offline::Line line = D1();
-  const TrainType t = Train("emu3_d1_weak");
-  const MarginModel m(line.Running("up"), t, ReferenceSpeedErrorModel());
-  const Location loc{LocationClass::kEndOfTrack, "end of track", 14'500'000, 10'000, 14'490'000};
-  const GridResult g = GridWorstCase(m, loc, 1000);
+  const GridResult g = GridWorstCase(D1UpModel("emu3_d1_weak").model, kD1EndOfTrack, 1000);
   EXPECT_LT(g.moving_margin_mm, -10'000.0);
   EXPECT_LT(g.margin_mm, -10'000.0);
   // the worst case is a high-speed approach braking with the weakest real deceleration

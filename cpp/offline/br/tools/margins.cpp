@@ -208,11 +208,7 @@ std::string Svg(const Job& job, const std::map<int, std::size_t>& worst_by_class
 int Main(int argc, char** argv) {
   const Options o = ParseArgs(argc, argv);
   const auto t_start = std::chrono::steady_clock::now();
-  auto progress = [&](const std::string& s) {
-    if (!o.quiet) {
-      std::fprintf(stderr, "margins: %s\n", s.c_str());
-    }
-  };
+  const railproof::offline::Progress progress("margins", o.quiet);
   std::vector<railproof::offline::Line> lines;
   for (const auto& f : o.lines) {
     lines.push_back(railproof::offline::LoadLine(f));
@@ -373,7 +369,7 @@ int Main(int argc, char** argv) {
             std::filesystem::create_directories(o.cases_dir);
             std::string name = job.line->name + "_" + job.rl->id + "_" + job.train->name + "_" + an::ToString(row.loc.cls) + "_" +
                                std::to_string(row.loc.stop_limit_mm) + ".json";
-            railproof::offline::WriteFileAtomic(std::filesystem::path(o.cases_dir) / name, row.fals->regression_case.dump(1) + "\n");
+            railproof::offline::WriteJsonFile(std::filesystem::path(o.cases_dir) / name, row.fals->regression_case);
           }
         }
       }
@@ -540,9 +536,9 @@ int Main(int argc, char** argv) {
   } else {
     out["details"] = std::filesystem::path(o.details).filename().string();
     const Json details{{"schema", "railproof/margins-details/1"}, {"skipped", skipped}, {"rows", rows}};
-    railproof::offline::WriteFileAtomic(o.details, details.dump(1) + "\n");
+    railproof::offline::WriteJsonFile(o.details, details);
   }
-  railproof::offline::WriteFileAtomic(o.json, out.dump(1) + "\n");
+  railproof::offline::WriteJsonFile(o.json, out);
   std::printf("%zu location x train rows (%zu skipped near the line start), grid %.1f s, %zu NLP %.1f s, %zu falsifier %.1f s (%zu violation(s)); total %.1f s: %s\n",
               tasks.size(), skipped_total, grid_wall, nlp_runs, nlp_wall, fals_runs, fals_wall, fals_found, wall,
               pass ? "PASS" : "FAIL");

@@ -169,25 +169,23 @@ std::string RenderSvg(const an::SpeedCheckDesign& d, const an::SpeedCheckDesign&
 // ---- JSON ------------------------------------------------------------------------------
 
 Json RowJson(const an::CheckSpeedRow& r) {
-  Json j;
-  j["check_speed_kmh"] = r.check_speed_kmh;
-  j["f_2e_hz"] = r.f_2e_hz;
-  j["n_2e"] = r.n_2e;
-  j["gate_s"] = r.gate_s;
-  j["threshold_kmh"] = r.threshold_kmh;
-  j["static_error_kmh"] = r.static_kmh;
-  j["dynamic_error_kmh"] = r.dynamic_kmh;
-  j["dynamic_error_linear_kmh"] = r.dynamic_linear_kmh;
-  j["total_error_kmh"] = r.total_kmh;
-  j["static_error_pct_of_check_speed"] = 100.0 * r.static_kmh / r.check_speed_kmh;
-  j["dynamic_error_pct_of_check_speed"] = 100.0 * r.dynamic_kmh / r.check_speed_kmh;
-  j["total_error_pct_of_check_speed"] = r.total_pct_of_check;
-  j["total_error_pct_of_design_max"] = r.total_pct_of_max;
-  j["target_kmh"] = r.target_kmh;
-  j["meets_target"] = r.meets_target;
-  j["tg_limit_hz"] = r.tg_limit_hz;
-  j["tg_constraint_met"] = r.tg_ok;
-  return j;
+  return Json{{"check_speed_kmh", r.check_speed_kmh},
+              {"f_2e_hz", r.f_2e_hz},
+              {"n_2e", r.n_2e},
+              {"gate_s", r.gate_s},
+              {"threshold_kmh", r.threshold_kmh},
+              {"static_error_kmh", r.static_kmh},
+              {"dynamic_error_kmh", r.dynamic_kmh},
+              {"dynamic_error_linear_kmh", r.dynamic_linear_kmh},
+              {"total_error_kmh", r.total_kmh},
+              {"static_error_pct_of_check_speed", 100.0 * r.static_kmh / r.check_speed_kmh},
+              {"dynamic_error_pct_of_check_speed", 100.0 * r.dynamic_kmh / r.check_speed_kmh},
+              {"total_error_pct_of_check_speed", r.total_pct_of_check},
+              {"total_error_pct_of_design_max", r.total_pct_of_max},
+              {"target_kmh", r.target_kmh},
+              {"meets_target", r.meets_target},
+              {"tg_limit_hz", r.tg_limit_hz},
+              {"tg_constraint_met", r.tg_ok}};
 }
 
 Json ComparisonJson(const an::SpeedCheckDesign& d, const std::string& what) {
@@ -365,7 +363,7 @@ int Main(int argc, char** argv) {
                   worst_dev, worst_at);
     notes.push_back(note);
     j["notes"] = notes;
-    railproof::offline::WriteFileAtomic(o.json_path, j.dump(1) + "\n");
+    railproof::offline::WriteJsonFile(o.json_path, j);
   }
   if (!o.svg_path.empty()) {
     railproof::offline::WriteFileAtomic(o.svg_path, RenderSvg(d, fixed, 10.0 * an::AsymptoteN1F(in)));

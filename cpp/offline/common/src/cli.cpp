@@ -143,6 +143,13 @@ void Cli::Fail(const std::string& reason) const {
   std::exit(kUsageExit);
 }
 
+void Progress::operator()(const std::string& text) const {
+  if (!quiet_) {
+    const std::lock_guard<std::mutex> lock(mu_);
+    std::fprintf(stderr, "%s: %s\n", tool_.c_str(), text.c_str());
+  }
+}
+
 int RunTool(const std::string& tool, const std::function<int()>& body) {
   try {
     return body();

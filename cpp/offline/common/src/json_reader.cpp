@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <fstream>
 #include <limits>
+#include <sstream>
 #include <string>
 #include <utility>
 
@@ -32,11 +34,13 @@ void JsonNode::Fail(const std::string& reason) const {
   throw InputError(*file_ + ": " + (path_.empty() ? std::string("(top level)") : path_) + ": " + reason);
 }
 
-void JsonNode::RequireObject() const {
-  if (!value_->is_object()) {
-    Fail("expected an object, got " + JsonTypeName(*value_));
+void JsonNode::RequireType(bool is_expected, std::string_view what) const {
+  if (!is_expected) {
+    Fail("expected " + std::string(what) + ", got " + JsonTypeName(*value_));
   }
 }
+
+void JsonNode::RequireObject() const { RequireType(value_->is_object(), "an object"); }
 
 namespace {
 std::string Join(const std::string& path, std::string_view key) {
@@ -84,16 +88,12 @@ std::int64_t JsonNode::Int() const {
     }
     return static_cast<std::int64_t>(u);
   }
-  if (!value_->is_number_integer()) {
-    Fail("expected an integer, got " + JsonTypeName(*value_));
-  }
+  RequireType(value_->is_number_integer(), "an integer");
   return value_->get<std::int64_t>();
 }
 
 double JsonNode::Number() const {
-  if (!value_->is_number()) {
-    Fail("expected a number, got " + JsonTypeName(*value_));
-  }
+  RequireType(value_->is_number(), "a number");
   const double v = value_->get<double>();
   if (!std::isfinite(v)) {
     Fail("expected a finite number");
@@ -102,23 +102,17 @@ double JsonNode::Number() const {
 }
 
 std::string JsonNode::String() const {
-  if (!value_->is_string()) {
-    Fail("expected a string, got " + JsonTypeName(*value_));
-  }
+  RequireType(value_->is_string(), "a string");
   return value_->get<std::string>();
 }
 
 bool JsonNode::Bool() const {
-  if (!value_->is_boolean()) {
-    Fail("expected true or false, got " + JsonTypeName(*value_));
-  }
+  RequireType(value_->is_boolean(), "true or false");
   return value_->get<bool>();
 }
 
 std::vector<JsonNode> JsonNode::Array() const {
-  if (!value_->is_array()) {
-    Fail("expected an array, got " + JsonTypeName(*value_));
-  }
+  RequireType(value_->is_array(), "an array");
   std::vector<JsonNode> out;
   out.reserve(value_->size());
   for (std::size_t i = 0; i < value_->size(); ++i) {
@@ -127,8 +121,38 @@ std::vector<JsonNode> JsonNode::Array() const {
   return out;
 }
 
+std::vector<JsonNode> JsonNode::NonEmptyArray(const std::string& if_empty) const {
+  std::vector<JsonNode> out = Array();
+  if (out.empty()) {
+    Fail(if_empty);
+  }
+  return out;
+}
+
 JsonNode JsonNode::Labelled(const std::string& label) const {
   return JsonNode(*value_, path_ + " (" + label + ")", *file_);
+}
+
+JsonDocument::JsonDocument(std::string_view text, const std::string& file)
+    : ParsedJson{Parse(text, file)}, JsonNode(doc, "", file) {}
+
+JsonDocument::JsonDocument(std::string_view text, const std::string& file, std::string_view schema,
+                           std::string_view note)
+    : JsonDocument(text, file) {
+  const JsonNode s = Key("schema");
+  if (s.String() != schema) {
+    s.Fail("unsupported schema '" + s.String() + "', expected '" + std::string(schema) + "'" + std::string(note));
+  }
+}
+
+std::string ReadInputFile(const std::filesystem::path& path, std::string_view what) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    throw InputError(path.string() + ": cannot read" + (what.empty() ? "" : " " + std::string(what)));
+  }
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
 }
 
 }  // namespace railproof::offline

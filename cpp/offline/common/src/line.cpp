@@ -2,9 +2,7 @@
 #include "railproof/offline/line.hpp"
 
 #include <algorithm>
-#include <fstream>
 #include <set>
-#include <sstream>
 #include <string>
 #include <utility>
 
@@ -52,6 +50,18 @@ std::string ReadId(const JsonNode& n, std::set<std::string>& seen, std::string_v
   return id;
 }
 
+// Calls `read(node, id)` for every entry of the array `key` of `parent`, in order: `id` is the
+// entry's identifier (member `id_key`: not empty, unique in the array) and `node` the entry
+// labelled with it.
+template <typename Read>
+void ReadIdentified(const JsonNode& parent, std::string_view key, std::string_view id_key, const Read& read) {
+  std::set<std::string> ids;
+  for (const auto& entry : parent.Key(key).Array()) {
+    std::string id = ReadId(entry, ids, id_key);
+    read(entry.Labelled(id), std::move(id));
+  }
+}
+
 // Sections that must cover [0, length) in order, without gap or overlap.
 void CheckCover(const std::vector<JsonNode>& nodes, const std::vector<Section>& sections,
                 std::int64_t length_mm, const JsonNode& parent, std::string_view what) {
@@ -86,11 +96,9 @@ void CheckDisjoint(const std::vector<JsonNode>& nodes, const std::vector<Section
 // @implements REQ-LC-016
 void ReadLevelCrossings(const JsonNode& rn, std::int64_t length_mm, RunningLine& rl) {
   namespace lcp = railproof::params::lc;
-  std::set<std::string> ids;
-  for (const auto& n0 : rn.Key("level_crossings").Array()) {
+  ReadIdentified(rn, "level_crossings", "id", [&](const JsonNode& n, std::string id) {
     LevelCrossing lc;
-    lc.id = ReadId(n0, ids);
-    const JsonNode n = n0.Labelled(lc.id);
+    lc.id = std::move(id);
     n.AllowOnly({"id", "position_mm", "width_mm", "warning_time_ms"});
     lc.position_mm = ReadPosition(n.Key("position_mm"), length_mm);
     lc.width_mm = n.Key("width_mm").Int();
@@ -130,7 +138,7 @@ void ReadLevelCrossings(const JsonNode& rn, std::int64_t length_mm, RunningLine&
       }
     }
     rl.level_crossings.push_back(lc);
-  }
+  });
 }
 
 RunningLine ReadRunningLine(const JsonNode& rn0, std::set<std::string>& running_ids) {
@@ -208,63 +216,44 @@ RunningLine ReadRunningLine(const JsonNode& rn0, std::set<std::string>& running_
     }
     CheckCover(nodes, secs, L, sn, "speed_limits");
   }
-  {
-    std::set<std::string> ids;
-    const auto nodes = rn.Key("balises").Array();
-    for (const auto& n0 : nodes) {
-      Balise b;
-      b.id = ReadId(n0, ids);
-      const JsonNode n = n0.Labelled(b.id);
-      b.position_mm = ReadPosition(n.Key("position_mm"), L);
-      if (!rl.balises.empty() && b.position_mm < rl.balises.back().position_mm) {
-        n.Fail("balise at " + Mm(b.position_mm) + " mm listed after one at " +
-               Mm(rl.balises.back().position_mm) + " mm (must be sorted)");
-      }
-      rl.balises.push_back(b);
+  ReadIdentified(rn, "balises", "id", [&](const JsonNode& n, std::string id) {
+    Balise b{std::move(id), ReadPosition(n.Key("position_mm"), L)};
+    if (!rl.balises.empty() && b.position_mm < rl.balises.back().position_mm) {
+      n.Fail("balise at " + Mm(b.position_mm) + " mm listed after one at " + Mm(rl.balises.back().position_mm) +
+             " mm (must be sorted)");
     }
-  }
-  {
-    std::set<std::string> names;
-    const auto nodes = rn.Key("stations").Array();
-    for (const auto& n0 : nodes) {
-      Station s;
-      s.name = ReadId(n0, names, "name");
-      const JsonNode n = n0.Labelled(s.name);
-      s.platform = Section{n.Key("platform_begin_mm").Int(), n.Key("platform_end_mm").Int()};
-      if (s.platform.begin_mm < 0 || s.platform.end_mm > L || s.platform.begin_mm >= s.platform.end_mm) {
-        n.Fail("platform [" + Mm(s.platform.begin_mm) + ", " + Mm(s.platform.end_mm) +
-               ") mm is empty or lies outside the line");
-      }
-      s.stop_mm = n.Key("stop_mm").Int();
-      if (s.stop_mm <= s.platform.begin_mm || s.stop_mm > s.platform.end_mm) {
-        n.Key("stop_mm").Fail("stop " + Mm(s.stop_mm) + " mm lies outside the platform (" +
-                              Mm(s.platform.begin_mm) + ", " + Mm(s.platform.end_mm) + "]");
-      }
-      s.fixed_block = n.Key("fixed_block").Bool();
-      s.setback = n.Key("setback").Bool();
-      if (!rl.stations.empty() && s.stop_mm <= rl.stations.back().stop_mm) {
-        n.Fail("station stop " + Mm(s.stop_mm) + " mm not after the previous station's " +
-               Mm(rl.stations.back().stop_mm) + " mm (must be sorted)");
-      }
-      rl.stations.push_back(s);
+    rl.balises.push_back(b);
+  });
+  ReadIdentified(rn, "stations", "name", [&](const JsonNode& n, std::string name) {
+    Station s;
+    s.name = std::move(name);
+    s.platform = Section{n.Key("platform_begin_mm").Int(), n.Key("platform_end_mm").Int()};
+    if (s.platform.begin_mm < 0 || s.platform.end_mm > L || s.platform.begin_mm >= s.platform.end_mm) {
+      n.Fail("platform [" + Mm(s.platform.begin_mm) + ", " + Mm(s.platform.end_mm) +
+             ") mm is empty or lies outside the line");
     }
-  }
-  {
-    std::set<std::string> ids;
-    const auto nodes = rn.Key("points").Array();
-    for (const auto& n0 : nodes) {
-      Points p;
-      p.id = ReadId(n0, ids);
-      const JsonNode n = n0.Labelled(p.id);
-      p.section = ReadSection(n, L);
-      const auto it = std::find(rl.blocks_mm.begin(), rl.blocks_mm.end(), p.section.begin_mm);
-      if (it == rl.blocks_mm.end() || std::next(it) == rl.blocks_mm.end() || *std::next(it) != p.section.end_mm) {
-        n.Fail("points section [" + Mm(p.section.begin_mm) + ", " + Mm(p.section.end_mm) +
-               ") mm is not exactly one virtual block");
-      }
-      rl.points.push_back(p);
+    s.stop_mm = n.Key("stop_mm").Int();
+    if (s.stop_mm <= s.platform.begin_mm || s.stop_mm > s.platform.end_mm) {
+      n.Key("stop_mm").Fail("stop " + Mm(s.stop_mm) + " mm lies outside the platform (" +
+                            Mm(s.platform.begin_mm) + ", " + Mm(s.platform.end_mm) + "]");
     }
-  }
+    s.fixed_block = n.Key("fixed_block").Bool();
+    s.setback = n.Key("setback").Bool();
+    if (!rl.stations.empty() && s.stop_mm <= rl.stations.back().stop_mm) {
+      n.Fail("station stop " + Mm(s.stop_mm) + " mm not after the previous station's " +
+             Mm(rl.stations.back().stop_mm) + " mm (must be sorted)");
+    }
+    rl.stations.push_back(s);
+  });
+  ReadIdentified(rn, "points", "id", [&](const JsonNode& n, std::string id) {
+    Points p{std::move(id), ReadSection(n, L)};
+    const auto it = std::find(rl.blocks_mm.begin(), rl.blocks_mm.end(), p.section.begin_mm);
+    if (it == rl.blocks_mm.end() || std::next(it) == rl.blocks_mm.end() || *std::next(it) != p.section.end_mm) {
+      n.Fail("points section [" + Mm(p.section.begin_mm) + ", " + Mm(p.section.end_mm) +
+             ") mm is not exactly one virtual block");
+    }
+    rl.points.push_back(p);
+  });
   {
     std::set<std::int64_t> ids;
     const auto nodes = rn.Key("routes").Array();
@@ -309,22 +298,17 @@ RunningLine ReadRunningLine(const JsonNode& rn0, std::set<std::string>& running_
     }
     CheckCover(nodes, secs, L, cn, "radio_cells");
   }
-  {
-    std::set<std::string> ids;
-    for (const auto& n0 : rn.Key("handovers").Array()) {
-      Handover h;
-      h.id = ReadId(n0, ids);
-      const JsonNode pn = n0.Labelled(h.id).Key("position_mm");
-      h.position_mm = ReadPosition(pn, L);
-      const bool at_boundary = std::any_of(rl.radio_cells.begin(), rl.radio_cells.end(), [&](const RadioCell& c) {
-        return c.section.begin_mm == h.position_mm && c.section.begin_mm > 0;
-      });
-      if (!at_boundary) {
-        pn.Fail("handover at " + Mm(h.position_mm) + " mm is not at a boundary between two radio cells");
-      }
-      rl.handovers.push_back(h);
+  ReadIdentified(rn, "handovers", "id", [&](const JsonNode& n, std::string id) {
+    const JsonNode pn = n.Key("position_mm");
+    Handover h{std::move(id), ReadPosition(pn, L)};
+    const bool at_boundary = std::any_of(rl.radio_cells.begin(), rl.radio_cells.end(), [&](const RadioCell& c) {
+      return c.section.begin_mm == h.position_mm && c.section.begin_mm > 0;
+    });
+    if (!at_boundary) {
+      pn.Fail("handover at " + Mm(h.position_mm) + " mm is not at a boundary between two radio cells");
     }
-  }
+    rl.handovers.push_back(h);
+  });
   {
     const auto nodes = rn.Key("no_stop_sections").Array();
     for (const auto& n : nodes) {
@@ -395,14 +379,9 @@ const RunningLine& Line::Running(std::string_view running_id) const {
 }
 
 Line ParseLine(std::string_view text, const std::string& file) {
-  const nlohmann::json doc = JsonNode::Parse(text, file);
-  const JsonNode root(doc, "", file);
+  const JsonDocument root(text, file, kLineSchema);
   Line line;
   line.file = file;
-  const JsonNode schema = root.Key("schema");
-  if (schema.String() != kLineSchema) {
-    schema.Fail("unsupported schema '" + schema.String() + "', expected '" + std::string(kLineSchema) + "'");
-  }
   line.name = root.Key("name").String();
   if (line.name.empty()) {
     root.Key("name").Fail("empty name");
@@ -412,27 +391,14 @@ Line ParseLine(std::string_view text, const std::string& file) {
   for (const auto& s : root.Key("source").Array()) {
     line.source.push_back(s.String());
   }
-  const JsonNode rls = root.Key("running_lines");
-  const auto nodes = rls.Array();
-  if (nodes.empty()) {
-    rls.Fail("no running line");
-  }
   std::set<std::string> ids;
-  for (const auto& n : nodes) {
+  for (const auto& n : root.Key("running_lines").NonEmptyArray("no running line")) {
     line.running_lines.push_back(ReadRunningLine(n, ids));
   }
   return line;
 }
 
-Line LoadLine(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    throw InputError(path.string() + ": cannot read line file");
-  }
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ParseLine(ss.str(), path.string());
-}
+Line LoadLine(const std::filesystem::path& path) { return ParseLine(ReadInputFile(path, "line file"), path.string()); }
 
 std::filesystem::path LinePath(const std::filesystem::path& lines_dir, std::string_view name) {
   return lines_dir / (std::string(name) + ".json");

@@ -2,8 +2,6 @@
 #include "railproof/offline/train_type.hpp"
 
 #include <algorithm>
-#include <fstream>
-#include <sstream>
 #include <string>
 
 #include "railproof/offline/json_reader.hpp"
@@ -45,8 +43,7 @@ Range RangeIn(const JsonNode& n, std::int64_t lo, std::int64_t hi, const char* u
 
 // @implements REQ-BR-010
 TrainType ParseTrainType(std::string_view text, const std::string& file) {
-  const nlohmann::json doc = JsonNode::Parse(text, file);
-  const JsonNode root(doc, "", file);
+  const JsonDocument root(text, file);
   root.AllowOnly({"schema", "name", "title", "source", "assumption", "length_mm", "max_speed_kmh", "accel_max_mm_s2",
                   "braking", "supervision", "uncertainty", "design_rule_violations"});
   const std::string schema = root.Key("schema").String();
@@ -108,13 +105,7 @@ TrainType ParseTrainType(std::string_view text, const std::string& file) {
 
 // @implements REQ-BR-010
 TrainType LoadTrainType(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    throw InputError(path.string() + ": cannot read train type");
-  }
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ParseTrainType(ss.str(), path.string());
+  return ParseTrainType(ReadInputFile(path, "train type"), path.string());
 }
 
 br::TrainData ToTrainData(const TrainType& t) {

@@ -6,7 +6,10 @@
 
 #include <filesystem>
 #include <fstream>
+#include <cstddef>
+#include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -29,6 +32,20 @@ nlohmann::json D4Json() {
 
 // The first crossing of the up running line of the D4 line (LC01, centre 1500 m, 6 m wide).
 nlohmann::json& FirstCrossing(nlohmann::json& j) { return j["running_lines"][0]["level_crossings"][0]; }
+
+// Inserts a copy of the first crossing as crossing `index` of the up running line, named `id`,
+// centred at `position_mm` and, if given, `width_mm` wide.
+void InsertCrossing(nlohmann::json& j, std::size_t index, const std::string& id, std::int64_t position_mm,
+                    std::optional<std::int64_t> width_mm = std::nullopt) {
+  auto& lcs = j["running_lines"][0]["level_crossings"];
+  nlohmann::json c = lcs[0];
+  c["id"] = id;
+  c["position_mm"] = position_mm;
+  if (width_mm) {
+    c["width_mm"] = *width_mm;
+  }
+  lcs.insert(lcs.begin() + static_cast<std::ptrdiff_t>(index), c);
+}
 
 void ExpectCrossingError(const std::function<void(nlohmann::json&)>& mutate, const std::vector<std::string>& fragments) {
   nlohmann::json j = D4Json();
@@ -108,41 +125,22 @@ TEST(SimLineCrossings, RejectsAWarningTimeBelowTheMinimum) {
 
 // @verifies REQ-LC-016
 TEST(SimLineCrossings, RejectsOverlappingCrossings) {
-  ExpectCrossingError(
-      [](nlohmann::json& j) {
-        auto& lcs = j["running_lines"][0]["level_crossings"];
-        nlohmann::json second = lcs[0];
-        second["id"] = "LC01b";
-        second["position_mm"] = 1'505'000;  // [1502000, 1508000) overlaps [1497000, 1503000)
-        lcs.insert(lcs.begin() + 1, second);
-      },
-      {"(LC01b)", "level crossing LC01b [1502000, 1508000) mm overlaps LC01 [1497000, 1503000) mm"});
+  // [1502000, 1508000) overlaps [1497000, 1503000)
+  ExpectCrossingError([](nlohmann::json& j) { InsertCrossing(j, 1, "LC01b", 1'505'000); },
+                      {"(LC01b)", "level crossing LC01b [1502000, 1508000) mm overlaps LC01 [1497000, 1503000) mm"});
   // crossings out of order
   ExpectCrossingError(
       [](nlohmann::json& j) {
-        auto& lcs = j["running_lines"][0]["level_crossings"];
-        lcs[0]["width_mm"] = 40'000;  // [1480000, 1520000)
-        nlohmann::json b = lcs[0], c = lcs[0];
-        b["id"] = "B";
-        b["position_mm"] = 1'530'000;
-        b["width_mm"] = 2'000;  // [1529000, 1531000): clear of LC01
-        c["id"] = "C";
-        c["position_mm"] = 1'510'000;  // out of order: listed after B
-        c["width_mm"] = 2'000;
-        lcs.insert(lcs.begin() + 1, b);
-        lcs.insert(lcs.begin() + 2, c);
+        FirstCrossing(j)["width_mm"] = 40'000;        // [1480000, 1520000)
+        InsertCrossing(j, 1, "B", 1'530'000, 2'000);  // [1529000, 1531000): clear of LC01
+        InsertCrossing(j, 2, "C", 1'510'000, 2'000);  // out of order: listed after B
       },
       {"(C)", "must be sorted"});
   // a narrow crossing inside a wide one
   ExpectCrossingError(
       [](nlohmann::json& j) {
-        auto& lcs = j["running_lines"][0]["level_crossings"];
-        lcs[0]["width_mm"] = 40'000;  // [1480000, 1520000)
-        nlohmann::json c = lcs[0];
-        c["id"] = "C";
-        c["position_mm"] = 1'515'000;
-        c["width_mm"] = 2'000;
-        lcs.insert(lcs.begin() + 1, c);
+        FirstCrossing(j)["width_mm"] = 40'000;  // [1480000, 1520000)
+        InsertCrossing(j, 1, "C", 1'515'000, 2'000);
       },
       {"level crossing C [1514000, 1516000) mm overlaps LC01 [1480000, 1520000) mm"});
 }

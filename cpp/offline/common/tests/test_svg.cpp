@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <cstddef>
+#include <initializer_list>
 #include <string>
 
 #include "railproof/offline/svg.hpp"
@@ -19,6 +20,13 @@ std::size_t Count(const std::string& text, const std::string& part) {
   return n;
 }
 
+// Expects every part in the text.
+void ExpectContains(const std::string& text, std::initializer_list<const char*> parts) {
+  for (const char* part : parts) {
+    EXPECT_NE(text.find(part), std::string::npos) << part;
+  }
+}
+
 TEST(SvgPlot, WritesAxesLinesShadesAndLegend) {
   SvgPlot plot(0.0, 600.0, 0.0, 14.5);
   plot.SetTitle("a <title> & more");
@@ -30,13 +38,13 @@ TEST(SvgPlot, WritesAxesLinesShadesAndLegend) {
   plot.AddLegend("train 2", SvgStyle{"#ff0000", 1.5, "", 1.0});
   const std::string svg = plot.Render();
   EXPECT_EQ(svg.rfind("<?xml", 0), 0U);
-  EXPECT_NE(svg.find("<svg xmlns=\"http://www.w3.org/2000/svg\""), std::string::npos);
-  EXPECT_NE(svg.find("a &lt;title&gt; &amp; more"), std::string::npos);
-  EXPECT_NE(svg.find("time [s]"), std::string::npos);
-  EXPECT_NE(svg.find("distance [km]"), std::string::npos);
-  EXPECT_NE(svg.find("possession 1"), std::string::npos);
-  EXPECT_NE(svg.find("train 2"), std::string::npos);
-  EXPECT_NE(svg.find("stroke-dasharray=\"2 3\""), std::string::npos);
+  ExpectContains(svg, {"<svg xmlns=\"http://www.w3.org/2000/svg\"",
+                       "a &lt;title&gt; &amp; more",
+                       "time [s]",
+                       "distance [km]",
+                       "possession 1",
+                       "train 2",
+                       "stroke-dasharray=\"2 3\""});
   // the NaN breaks the polyline into two pieces
   const auto path = svg.find("<path d=\"M");
   ASSERT_NE(path, std::string::npos);
@@ -59,11 +67,11 @@ TEST(SvgPlot, SeriesAreasVerticalLinesTextAndLegendKinds) {
   EXPECT_EQ(Count(svg, "stroke=\"#112233\""), 2U);
   EXPECT_NE(svg.find(" Z\" fill=\"#445566\" fill-opacity=\"0.2\""), std::string::npos);  // F() rounds to 0.1
   // the vertical line spans the plot area at x = 5 (half way: 90 + 1070 / 2)
-  EXPECT_NE(svg.find("<line x1=\"625.0\" x2=\"625.0\" y1=\"50.0\" y2=\"800.0\""), std::string::npos);
-  EXPECT_NE(svg.find(">asymptote</text>"), std::string::npos);
-  EXPECT_NE(svg.find("text-anchor=\"end\">note</text>"), std::string::npos);
-  EXPECT_NE(svg.find("fill=\"#aabbcc\" fill-opacity=\"0.5\""), std::string::npos);
-  EXPECT_NE(svg.find("r=\"4\" fill=\"#ddeeff\""), std::string::npos);
+  ExpectContains(svg, {"<line x1=\"625.0\" x2=\"625.0\" y1=\"50.0\" y2=\"800.0\"",
+                       ">asymptote</text>",
+                       "text-anchor=\"end\">note</text>",
+                       "fill=\"#aabbcc\" fill-opacity=\"0.5\"",
+                       "r=\"4\" fill=\"#ddeeff\""});
 }
 
 TEST(SvgPlot, LogarithmicAxisTicksAndNonPositiveValues) {
@@ -72,9 +80,7 @@ TEST(SvgPlot, LogarithmicAxisTicksAndNonPositiveValues) {
   plot.AddPolyline({{0.0, 1e3}, {0.5, 0.0}, {1.0, 1e5}}, SvgStyle{});
   const std::string svg = plot.Render();
   // ticks 1, 2, 5 x 10^k from 1000 to 100000; the decades darker
-  for (const char* tick : {">1000<", ">2000<", ">5000<", ">10000<", ">20000<", ">50000<", ">100000<"}) {
-    EXPECT_NE(svg.find(tick), std::string::npos) << tick;
-  }
+  ExpectContains(svg, {">1000<", ">2000<", ">5000<", ">10000<", ">20000<", ">50000<", ">100000<"});
   EXPECT_EQ(Count(svg, "stroke=\"#b0b0b0\""), 3U);
   // 1000 at the bottom (y 800), 100000 at the top (y 50); 0 breaks the line
   EXPECT_NE(svg.find("<path d=\"M90.0 800.0 M1160.0 50.0\""), std::string::npos);
@@ -99,12 +105,12 @@ TEST(SvgStack, StacksPlotsWithTheirOwnClipPaths) {
   b.SetTitle("second");
   const std::string svg = SvgStack({a, b});
   EXPECT_EQ(svg.rfind("<?xml", 0), 0U);
-  EXPECT_NE(svg.find("height=\"1720.0\""), std::string::npos);
-  EXPECT_NE(svg.find("<svg y=\"0.0\""), std::string::npos);
-  EXPECT_NE(svg.find("<svg y=\"860.0\""), std::string::npos);
-  EXPECT_NE(svg.find("clipPath id=\"plot0\""), std::string::npos);
-  EXPECT_NE(svg.find("clipPath id=\"plot1\""), std::string::npos);
-  EXPECT_NE(svg.find("url(#plot1)"), std::string::npos);
+  ExpectContains(svg, {"height=\"1720.0\"",
+                       "<svg y=\"0.0\"",
+                       "<svg y=\"860.0\"",
+                       "clipPath id=\"plot0\"",
+                       "clipPath id=\"plot1\"",
+                       "url(#plot1)"});
   EXPECT_EQ(Count(svg, "xmlns="), 1U);
   EXPECT_EQ(Count(svg, "</svg>"), 3U);
   EXPECT_LT(svg.find("first"), svg.find("second"));

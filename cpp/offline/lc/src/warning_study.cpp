@@ -5,6 +5,7 @@
 #include "railproof/lc/analysis/warning_study.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <deque>
 #include <limits>
@@ -187,34 +188,45 @@ std::optional<std::size_t> Run::StandingAt(double t_ms) const {
 
 // ============================================================================ methods
 
+namespace {
+
+// The name (JSON key, plot file) and the description of every method, in the order of Method.
+struct MethodText {
+  Method method;
+  const char* name;
+  const char* description;
+};
+constexpr std::array<MethodText, kMethodCount> kMethodTexts{{
+    {Method::kTreadle, "fixed_treadles",
+     "(a) fixed treadles at the distance giving the design warning time to the fastest train at the permitted speed"},
+    {Method::kOnboard, "onboard", "(b) on-board request (lc::onboard::CrossingProtection), no dwell awareness"},
+    {Method::kOnboardDwell, "onboard_dwell_aware",
+     "(b) on-board request, dwell-aware while standing at the stop (design note §2-§3, REQ-LC-005)"},
+    {Method::kOnboardApproach, "onboard_dwell_aware_approach",
+     "(b) on-board request, dwell-aware from the approach to the stop on (proposed extension of REQ-LC-005)"},
+    {Method::kGnss, "gnss_time",
+     "(c) GNSS-time pre-arming: start times from the planned departure, updates from position reports (report time "
+     "stamp)"},
+    {Method::kGnssReceiveTime, "gnss_time_receive_time_basis",
+     "(c) sensitivity: as (c) with updates computed from the centre's receive time (design note §5 item 4 read "
+     "literally)"},
+}};
+
+const MethodText* TextOf(Method m) {
+  const auto it = std::find_if(kMethodTexts.begin(), kMethodTexts.end(), [m](const MethodText& t) { return t.method == m; });
+  return it == kMethodTexts.end() ? nullptr : &*it;
+}
+
+}  // namespace
+
 const char* ToString(Method m) {
-  switch (m) {
-    case Method::kTreadle: return "fixed_treadles";
-    case Method::kOnboard: return "onboard";
-    case Method::kOnboardDwell: return "onboard_dwell_aware";
-    case Method::kOnboardApproach: return "onboard_dwell_aware_approach";
-    case Method::kGnss: return "gnss_time";
-    case Method::kGnssReceiveTime: return "gnss_time_receive_time_basis";
-  }
-  return "invalid";
+  const MethodText* t = TextOf(m);
+  return t != nullptr ? t->name : "invalid";
 }
 
 const char* Describe(Method m) {
-  switch (m) {
-    case Method::kTreadle:
-      return "(a) fixed treadles at the distance giving the design warning time to the fastest train at the permitted speed";
-    case Method::kOnboard:
-      return "(b) on-board request (lc::onboard::CrossingProtection), no dwell awareness";
-    case Method::kOnboardDwell:
-      return "(b) on-board request, dwell-aware while standing at the stop (design note §2-§3, REQ-LC-005)";
-    case Method::kOnboardApproach:
-      return "(b) on-board request, dwell-aware from the approach to the stop on (proposed extension of REQ-LC-005)";
-    case Method::kGnss:
-      return "(c) GNSS-time pre-arming: start times from the planned departure, updates from position reports (report time stamp)";
-    case Method::kGnssReceiveTime:
-      return "(c) sensitivity: as (c) with updates computed from the centre's receive time (design note §5 item 4 read literally)";
-  }
-  return "invalid";
+  const MethodText* t = TextOf(m);
+  return t != nullptr ? t->description : "invalid";
 }
 
 bool MustMeetDesignTime(Method m) {

@@ -3,8 +3,6 @@
 // stations and train types checked against spec/), and the check that the timetable fits the
 // line and train types the study is given (spec/timetables/README.md, spec/design/data.md).
 #include <cstdio>
-#include <fstream>
-#include <sstream>
 #include <string>
 
 #include "railproof/lc/analysis/warning_study.hpp"
@@ -13,6 +11,7 @@
 namespace railproof::lc::analysis {
 
 using offline::InputError;
+using offline::JsonDocument;
 using offline::JsonNode;
 
 std::string FormatClockTime(std::int64_t ms) {
@@ -55,13 +54,8 @@ constexpr std::int64_t kDayMs = 24 * 3'600'000;
 }  // namespace
 
 Timetable ParseTimetable(std::string_view text, const std::string& file) {
-  const nlohmann::json doc = JsonNode::Parse(text, file);
-  const JsonNode root(doc, "", file);
-  const std::string schema = root.Key("schema").String();
-  if (schema != kTimetableSchema) {
-    root.Key("schema").Fail("unsupported schema '" + schema + "', expected '" + std::string(kTimetableSchema) +
-                            "' (the JSON that railproof_testgen timetables writes from spec/timetables)");
-  }
+  const JsonDocument root(text, file, kTimetableSchema,
+                          " (the JSON that railproof_testgen timetables writes from spec/timetables)");
   Timetable tt;
   tt.file = file;
   tt.name = root.Key("name").String();
@@ -89,12 +83,7 @@ Timetable ParseTimetable(std::string_view text, const std::string& file) {
     tt.comms.onboard_clock_error_ms = IntIn(c.Key("onboard_clock_error_ms"), 0, 10'000, "ms");
     tt.comms.gnss_clock_error_ms = IntIn(c.Key("gnss_clock_error_ms"), 0, 10'000, "ms");
   }
-  const JsonNode sn = root.Key("services");
-  const auto nodes = sn.Array();
-  if (nodes.empty()) {
-    sn.Fail("no services");
-  }
-  for (const auto& n0 : nodes) {
+  for (const auto& n0 : root.Key("services").NonEmptyArray("no services")) {
     Service s;
     s.id = n0.Key("id").String();
     const JsonNode n = n0.Labelled(s.id);
@@ -116,13 +105,7 @@ Timetable ParseTimetable(std::string_view text, const std::string& file) {
 }
 
 Timetable LoadTimetable(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    throw InputError(path.string() + ": cannot read timetable file");
-  }
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ParseTimetable(ss.str(), path.string());
+  return ParseTimetable(ReadInputFile(path, "timetable file"), path.string());
 }
 
 namespace {

@@ -5,9 +5,11 @@
 
 #include <map>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "railproof/testing/gen_data.hpp"
+#include "railproof/testing/input_error.hpp"
 #include "railproof/lc/analysis/warning_study.hpp"
 #include "railproof/generated/lc_params.hpp"
 
@@ -81,6 +83,21 @@ Service MakeService(std::vector<ServiceStop> stops) {
   s.stops = std::move(stops);
   return s;
 }
+
+// One service (S1, stopping at `stops`) over `line` under the test timetable and train type.
+struct OneService {
+  OneService(offline::Line l, std::vector<ServiceStop> stops)
+      : line(std::move(l)), tt(MakeTimetable({MakeService(std::move(stops))})) {}
+  // The study with the on-board methods' request lead `lead_ms` (-1: the project's).
+  [[nodiscard]] StudyResult Run(std::int64_t lead_ms = -1) const {
+    StudyInputs in{&line, &tt, &trains};
+    in.request_lead_ms = lead_ms;
+    return RunStudy(in);
+  }
+  offline::Line line;
+  Timetable tt;
+  std::map<std::string, TrainType> trains = Trains();
+};
 
 double W(const Passage& p, Method m) { return p.warning_ms[static_cast<std::size_t>(m)] / 1000.0; }
 
@@ -164,12 +181,8 @@ TEST(WarningStudyRun, SectionAcceleratesCruisesAndBrakes) {
 // @verifies REQ-LC-008
 // @verifies REQ-LC-015
 TEST(WarningStudy, HandComputedWarningTimesOfASimpleRun) {
-  const offline::Line line = MakeLine({{"A", 500'000}, {"B", 9'500'000}}, {{"X", 5'000'000, 10'000, 30'000}});
-  const Timetable tt = MakeTimetable({MakeService({})});
-  const auto trains = Trains();
-  StudyInputs in{&line, &tt, &trains};
-  in.request_lead_ms = 6'000;
-  const StudyResult r = RunStudy(in);
+  const OneService one(MakeLine({{"A", 500'000}, {"B", 9'500'000}}, {{"X", 5'000'000, 10'000, 30'000}}), {});
+  const StudyResult r = one.Run(6'000);
   ASSERT_EQ(r.passages.size(), 1U);
   const Passage& p = r.passages[0];
   EXPECT_EQ(p.crossing, "X");
@@ -186,9 +199,7 @@ TEST(WarningStudy, HandComputedWarningTimesOfASimpleRun) {
   EXPECT_TRUE(p.braked[static_cast<std::size_t>(Method::kOnboardDwell)]);
   EXPECT_GT(p.arrival_ms - p.brake_at_ms[static_cast<std::size_t>(Method::kOnboardDwell)], 21'150.0);
   // a longer request lead: the confirmation comes before the pattern's first brake command
-  StudyInputs longer{&line, &tt, &trains};
-  longer.request_lead_ms = 15'000;
-  const StudyResult r15 = RunStudy(longer);
+  const StudyResult r15 = one.Run(15'000);
   const Passage& q = r15.passages.at(0);
   EXPECT_NEAR(W(q, Method::kOnboardDwell), 34.75 + 9.0, 0.002);
   for (Method m : {Method::kOnboard, Method::kOnboardDwell, Method::kOnboardApproach}) {
@@ -197,7 +208,7 @@ TEST(WarningStudy, HandComputedWarningTimesOfASimpleRun) {
   EXPECT_TRUE(StudyPasses(r15));
   // the project's request lead (spec/parameters/lc.yaml, chosen by the study's
   // sweep) avoids the braking here too
-  const StudyResult rp = RunStudy({&line, &tt, &trains});
+  const StudyResult rp = one.Run();
   EXPECT_FALSE(rp.passages.at(0).braked[static_cast<std::size_t>(Method::kOnboardDwell)]);
   EXPECT_NEAR(W(rp.passages.at(0), Method::kOnboardDwell), 34.75 + (lcp::request_lead_ms - 6'000) / 1000.0, 0.25);
 }
@@ -210,13 +221,10 @@ TEST(WarningStudy, HandComputedWarningTimesOfASimpleRun) {
 // @verifies REQ-LC-005
 // @verifies REQ-LC-017
 TEST(WarningStudy, DwellAwarenessAgainstNone) {
-  const offline::Line line =
-      MakeLine({{"A", 500'000}, {"M", 5'000'000}, {"B", 9'500'000}}, {{"X", 5'100'000, 10'000, 30'000}});
-  const Timetable tt = MakeTimetable({MakeService({{"M", 60'000}})});
-  const auto trains = Trains();
-  StudyInputs in{&line, &tt, &trains};
-  in.request_lead_ms = 15'000;  // long enough for the confirmation to come before the pattern
-  const StudyResult r = RunStudy(in);
+  const OneService one(
+      MakeLine({{"A", 500'000}, {"M", 5'000'000}, {"B", 9'500'000}}, {{"X", 5'100'000, 10'000, 30'000}}),
+      {{"M", 60'000}});
+  const StudyResult r = one.Run(15'000);  // long enough for the confirmation to come before the pattern
   ASSERT_EQ(r.passages.size(), 1U);
   const Passage& p = r.passages[0];
   EXPECT_TRUE(p.stop_in_approach);
@@ -243,12 +251,8 @@ TEST(WarningStudy, DwellAwarenessAgainstNone) {
 // before the departure-based arrival.
 // @verifies REQ-LC-005
 TEST(WarningStudy, DwellAwareAtTheOrigin) {
-  const offline::Line line = MakeLine({{"A", 500'000}, {"B", 9'500'000}}, {{"X", 805'000, 10'000, 30'000}});
-  const Timetable tt = MakeTimetable({MakeService({})});
-  const auto trains = Trains();
-  StudyInputs in{&line, &tt, &trains};
-  in.request_lead_ms = 6'000;
-  const StudyResult r = RunStudy(in);
+  const OneService one(MakeLine({{"A", 500'000}, {"B", 9'500'000}}, {{"X", 805'000, 10'000, 30'000}}), {});
+  const StudyResult r = one.Run(6'000);
   ASSERT_EQ(r.passages.size(), 1U);
   const Passage& p = r.passages[0];
   // from rest: 200 m in 20 s, 100 m at 20 m/s in 5 s -> 25 s to the near edge
@@ -265,11 +269,9 @@ TEST(WarningStudy, DwellAwareAtTheOrigin) {
 // pattern's first brake command, the train would have braked (REQ-LC-015 counts it).
 // @verifies REQ-LC-015
 TEST(WarningStudy, LateConfirmationIsCountedAsBraking) {
-  const offline::Line line = MakeLine({{"A", 500'000}, {"B", 9'500'000}}, {{"X", 5'000'000, 10'000, 30'000}});
-  Timetable tt = MakeTimetable({MakeService({})});
-  tt.comms.barrier_travel_ms = {20'000, 20'000};
-  const auto trains = Trains();
-  const StudyResult r = RunStudy({&line, &tt, &trains});
+  OneService one(MakeLine({{"A", 500'000}, {"B", 9'500'000}}, {{"X", 5'000'000, 10'000, 30'000}}), {});
+  one.tt.comms.barrier_travel_ms = {20'000, 20'000};
+  const StudyResult r = one.Run();
   ASSERT_EQ(r.passages.size(), 1U);
   EXPECT_TRUE(r.passages[0].braked[static_cast<std::size_t>(Method::kOnboardDwell)]);
   EXPECT_FALSE(StudyPasses(r));
@@ -319,20 +321,16 @@ std::string Edit(const std::string& from, const std::string& to) {
   return t.replace(pos, from.size(), to);
 }
 
+// The timetable text read and checked against the three-station line: an InputError naming
+// tt.json in one line with every fragment.
 void ExpectTimetableError(const std::string& text, const std::vector<std::string>& fragments) {
-  try {
-    const Timetable tt = ParseTimetable(text, "tt.json");
-    const offline::Line line = MakeLine({{"A", 500'000}, {"M", 5'000'000}, {"B", 9'500'000}}, {});
-    CheckTimetable(tt, line, Trains());
-    ADD_FAILURE() << "no error for " << fragments.front();
-  } catch (const InputError& e) {
-    const std::string msg = e.what();
-    EXPECT_EQ(msg.rfind("tt.json: ", 0), 0U) << msg;
-    EXPECT_EQ(msg.find('\n'), std::string::npos) << msg;
-    for (const auto& f : fragments) {
-      EXPECT_NE(msg.find(f), std::string::npos) << "'" << f << "' not in: " << msg;
-    }
-  }
+  testing::ExpectInputError(
+      [&] {
+        const Timetable tt = ParseTimetable(text, "tt.json");
+        const offline::Line line = MakeLine({{"A", 500'000}, {"M", 5'000'000}, {"B", 9'500'000}}, {});
+        CheckTimetable(tt, line, Trains());
+      },
+      "tt.json", fragments);
 }
 
 TEST(WarningStudyTimetable, ReadsTheTimetableJson) {
@@ -369,36 +367,40 @@ TEST(WarningStudyTimetable, TheProvidedTimetableFitsItsLine) {
 // (type, range, min <= max), and the timetable must fit the line and train types given.
 // @verifies REQ-LC-017
 TEST(WarningStudyTimetable, ErrorsNameFileEntryAndReason) {
-  ExpectTimetableError(Edit("railproof/timetable-json/1", "railproof/timetable/1"),
-                       {"tt.json: schema: unsupported schema 'railproof/timetable/1'"});
-  ExpectTimetableError(Edit("\"seed\": 7", "\"seed\": 1e300"), {"tt.json: seed: expected an integer, got number"});
-  ExpectTimetableError(Edit("\"depart_ms\": 21600000", "\"depart_ms\": \"06:00\""),
-                       {"services[0] (1).depart_ms", "expected an integer, got string"});
-  ExpectTimetableError(Edit("\"depart_ms\": 21600000", "\"depart_ms\": -1"),
-                       {"services[0] (1).depart_ms", "-1 ms is outside [0, 172799999]"});
-  ExpectTimetableError(Edit("\"cruise_percent\": [85, 100]", "\"cruise_percent\": [100, 85]"),
-                       {"driver.cruise_percent", "min 100 % is greater than max 85 %"});
-  ExpectTimetableError(Edit("\"cruise_percent\": [85, 100]", "\"cruise_percent\": [0, 100]"),
-                       {"driver.cruise_percent[0]", "0 % is outside [50, 100]"});
-  ExpectTimetableError(Edit("\"onboard_cycle_ms\": 200", "\"onboard_cycle_ms\": 0"),
-                       {"communication.onboard_cycle_ms", "outside [1, 10000]"});
-  ExpectTimetableError(Edit("\"planned_time_step_ms\": 5000", "\"planned_time_step_ms\": 5000.5"),
-                       {"planned_time_step_ms", "expected an integer, got number"});
-  ExpectTimetableError(Edit("\"uplink_ms\": [200, 1500]", "\"uplink_ms\": [200]"),
-                       {"communication.uplink_ms", "expected [min, max], got 1 element(s)"});
-  ExpectTimetableError(Edit("\"seed\": 7,", "\"seed\": 7"), {"tt.json: invalid JSON"});
-  ExpectTimetableError(Edit("\"station\": \"M\"", "\"station\": \"Q\""),
-                       {"services[0] (1).stops[0]", "station 'Q' has no stop on running line up"});
-  ExpectTimetableError(Edit("\"station\": \"M\"", "\"station\": \"B\""),
-                       {"services[0] (1).stops[0]", "stop at B is not between the origin A and the destination B"});
-  ExpectTimetableError(Edit("\"train\": \"unit\", \"running_line\": \"up\", \"depart_ms\": 21600000",
-                            "\"train\": \"tram\", \"running_line\": \"up\", \"depart_ms\": 21600000"),
-                       {"services[0] (1).train", "unknown train type 'tram'"});
-  ExpectTimetableError(Edit("\"running_line\": \"up\", \"depart_ms\": 21600000",
-                            "\"running_line\": \"left\", \"depart_ms\": 21600000"),
-                       {"services[0] (1).running_line", "unknown running line 'left'"});
-  ExpectTimetableError(Edit("\"line\": \"test_line\"", "\"line\": \"d9_line\""),
-                       {"tt.json: line", "timetable for line 'd9_line'"});
+  // (text replaced, replacement, fragments of the message)
+  const std::vector<std::tuple<std::string, std::string, std::vector<std::string>>> edits{
+      {"railproof/timetable-json/1", "railproof/timetable/1",
+       {"tt.json: schema: unsupported schema 'railproof/timetable/1'"}},
+      {"\"seed\": 7", "\"seed\": 1e300", {"tt.json: seed: expected an integer, got number"}},
+      {"\"depart_ms\": 21600000", "\"depart_ms\": \"06:00\"",
+       {"services[0] (1).depart_ms", "expected an integer, got string"}},
+      {"\"depart_ms\": 21600000", "\"depart_ms\": -1",
+       {"services[0] (1).depart_ms", "-1 ms is outside [0, 172799999]"}},
+      {"\"cruise_percent\": [85, 100]", "\"cruise_percent\": [100, 85]",
+       {"driver.cruise_percent", "min 100 % is greater than max 85 %"}},
+      {"\"cruise_percent\": [85, 100]", "\"cruise_percent\": [0, 100]",
+       {"driver.cruise_percent[0]", "0 % is outside [50, 100]"}},
+      {"\"onboard_cycle_ms\": 200", "\"onboard_cycle_ms\": 0",
+       {"communication.onboard_cycle_ms", "outside [1, 10000]"}},
+      {"\"planned_time_step_ms\": 5000", "\"planned_time_step_ms\": 5000.5",
+       {"planned_time_step_ms", "expected an integer, got number"}},
+      {"\"uplink_ms\": [200, 1500]", "\"uplink_ms\": [200]",
+       {"communication.uplink_ms", "expected [min, max], got 1 element(s)"}},
+      {"\"seed\": 7,", "\"seed\": 7", {"tt.json: invalid JSON"}},
+      {"\"station\": \"M\"", "\"station\": \"Q\"",
+       {"services[0] (1).stops[0]", "station 'Q' has no stop on running line up"}},
+      {"\"station\": \"M\"", "\"station\": \"B\"",
+       {"services[0] (1).stops[0]", "stop at B is not between the origin A and the destination B"}},
+      {"\"train\": \"unit\", \"running_line\": \"up\", \"depart_ms\": 21600000",
+       "\"train\": \"tram\", \"running_line\": \"up\", \"depart_ms\": 21600000",
+       {"services[0] (1).train", "unknown train type 'tram'"}},
+      {"\"running_line\": \"up\", \"depart_ms\": 21600000", "\"running_line\": \"left\", \"depart_ms\": 21600000",
+       {"services[0] (1).running_line", "unknown running line 'left'"}},
+      {"\"line\": \"test_line\"", "\"line\": \"d9_line\"", {"tt.json: line", "timetable for line 'd9_line'"}},
+  };
+  for (const auto& [from, to, fragments] : edits) {
+    ExpectTimetableError(Edit(from, to), fragments);
+  }
 }
 
 // @verifies REQ-LC-017

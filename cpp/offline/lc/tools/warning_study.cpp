@@ -103,7 +103,7 @@ int Main(int argc, char** argv) {
   }
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   json["statistics"]["wall_s"] = std::round(wall * 1000.0) / 1000.0;
-  railproof::offline::WriteFileAtomic(o.json, json.dump(1) + "\n");
+  railproof::offline::WriteJsonFile(o.json, json);
   if (!o.svg_dir.empty()) {
     std::filesystem::create_directories(o.svg_dir);
     for (an::Method m : {an::Method::kTreadle, an::Method::kOnboard, an::Method::kOnboardDwell, an::Method::kOnboardApproach,

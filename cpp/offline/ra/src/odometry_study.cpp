@@ -5,8 +5,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
-#include <fstream>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -115,12 +113,8 @@ std::filesystem::path LineOfTrain(const TrainType& t, const std::filesystem::pat
                      " line(s) '" + prefix + "*.json' in " + lines_dir.string() + ", expected exactly one");
   }
   // cross-check: the line's design train has the train's length
-  std::ifstream in(found.front(), std::ios::binary);
-  std::ostringstream ss;
-  ss << in.rdbuf();
   const std::string file = found.front().string();
-  const nlohmann::json doc = offline::JsonNode::Parse(ss.str(), file);
-  const offline::JsonNode root(doc, "", file);
+  const offline::JsonDocument root(offline::ReadInputFile(file, "line file"), file);
   const offline::JsonNode len = root.Key("design_train_length_mm");
   if (len.Int() != t.length_mm) {
     len.Fail("design train length " + std::to_string(len.Int()) + " mm differs from train '" + t.name +

@@ -8,7 +8,8 @@
 // step dividing the IMU period, fields that belong to one fault type).
 #include <algorithm>
 #include <cmath>
-#include <fstream>
+#include <initializer_list>
+#include <span>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -36,6 +37,25 @@ double RangedKey(const JsonNode& n, std::string_view key, double def, double lo,
   return k ? Ranged(*k, lo, hi) : def;
 }
 
+// An optional member of a section, a number in [lo, hi]; absent or null, `value` keeps its
+// default.
+struct OptionalNumber {
+  std::string_view key;
+  double& value;
+  double lo;
+  double hi;
+};
+
+// The optional numbers of section `n`, in the order given.
+void ReadOptionalNumbers(const JsonNode& n, std::span<const OptionalNumber> fields) {
+  for (const auto& f : fields) {
+    f.value = RangedKey(n, f.key, f.value, f.lo, f.hi);
+  }
+}
+void ReadOptionalNumbers(const JsonNode& n, std::initializer_list<OptionalNumber> fields) {
+  ReadOptionalNumbers(n, std::span(fields.begin(), fields.size()));
+}
+
 std::string Fmt(double v) {
   std::ostringstream os;
   os << v;
@@ -50,10 +70,7 @@ void ParseVertical(const JsonNode& n, WheelRailScenario& sc) {
     n.Key("end_m").Fail("must be at least 100 m beyond begin_m");
   }
   v.vertical_curve_radius_m = RangedKey(n, "vertical_curve_radius_m", 3000.0, 500.0, 100000.0);
-  const auto arr = n.Key("gradients").Array();
-  if (arr.empty()) {
-    n.Key("gradients").Fail("at least one gradient expected");
-  }
+  const auto arr = n.Key("gradients").NonEmptyArray("at least one gradient expected");
   for (const auto& e : arr) {
     GradientPoint g;
     g.from_m = e.Key("from_m").Number();
@@ -155,11 +172,11 @@ void ParseRail(const JsonNode& n, WheelRailScenario& sc) {
 
 void ParseAdhesion(const JsonNode& n, WheelRailScenario& sc) {
   auto& a = sc.adhesion;
-  a.wet_factor = RangedKey(n, "wet_factor", a.wet_factor, 0.1, 1.0);
-  a.peak_creep = RangedKey(n, "peak_creep", a.peak_creep, 0.001, 0.1);
-  a.tail_creep = RangedKey(n, "tail_creep", a.tail_creep, 0.01, 1.0);
-  a.tail_ratio = RangedKey(n, "tail_ratio", a.tail_ratio, 0.1, 1.0);
-  a.creep_floor_mps = RangedKey(n, "creep_floor_mps", a.creep_floor_mps, 0.05, 2.0);
+  ReadOptionalNumbers(n, {{"wet_factor", a.wet_factor, 0.1, 1.0},
+                          {"peak_creep", a.peak_creep, 0.001, 0.1},
+                          {"tail_creep", a.tail_creep, 0.01, 1.0},
+                          {"tail_ratio", a.tail_ratio, 0.1, 1.0},
+                          {"creep_floor_mps", a.creep_floor_mps, 0.05, 2.0}});
   if (a.tail_creep <= a.peak_creep) {
     n.Key("tail_creep").Fail("must exceed peak_creep");
   }
@@ -167,26 +184,40 @@ void ParseAdhesion(const JsonNode& n, WheelRailScenario& sc) {
 
 void ParseVehicle(const JsonNode& n, WheelRailScenario& sc) {
   auto& v = sc.vehicle;
-  v.length_m = RangedKey(n, "length_m", v.length_m, 5.0, 40.0);
-  v.bogie_centres_m = RangedKey(n, "bogie_centres_m", v.bogie_centres_m, 3.0, 30.0);
-  v.axle_spacing_m = RangedKey(n, "axle_spacing_m", v.axle_spacing_m, 1.5, 4.0);
+  // the schema's order: the geometry is checked after axle_spacing_m, motored read after
+  // roll_coefficient
+  const OptionalNumber numbers[]{
+      {"length_m", v.length_m, 5.0, 40.0},
+      {"bogie_centres_m", v.bogie_centres_m, 3.0, 30.0},
+      {"axle_spacing_m", v.axle_spacing_m, 1.5, 4.0},
+      {"wheel_diameter_m", v.wheel_diameter_m, 0.5, 1.5},
+      {"body_mass_kg", v.body_mass_kg, 5000.0, 80000.0},
+      {"bogie_mass_kg", v.bogie_mass_kg, 500.0, 10000.0},
+      {"wheelset_mass_kg", v.wheelset_mass_kg, 300.0, 5000.0},
+      {"wheelset_inertia_kgm2", v.wheelset_inertia_kgm2, 10.0, 2000.0},
+      {"body_cog_height_m", v.body_cog_height_m, 1.0, 3.0},
+      {"primary_hz", v.primary_hz, 2.0, 15.0},
+      {"primary_damping", v.primary_damping, 0.0, 1.0},
+      {"secondary_hz", v.secondary_hz, 0.5, 3.0},
+      {"secondary_damping", v.secondary_damping, 0.0, 1.0},
+      {"roll_coefficient", v.roll_coefficient, 0.0, 0.5},
+      {"max_traction_force_n", v.max_traction_force_n, 0.0, 100000.0},
+      {"max_power_w", v.max_power_w, 1000.0, 2e6},
+      {"max_brake_force_n", v.max_brake_force_n, 0.0, 100000.0},
+      {"resistance_a_n", v.resistance_a_n, 0.0, 20000.0},
+      {"resistance_b_ns_m", v.resistance_b_ns_m, 0.0, 2000.0},
+      {"resistance_c_ns2_m2", v.resistance_c_ns2_m2, 0.0, 200.0},
+      {"max_speed_kmh", v.max_speed_kmh, 10.0, 300.0},
+  };
+  const std::span<const OptionalNumber> all(numbers);
+  ReadOptionalNumbers(n, all.first(3));
   if (v.bogie_centres_m + v.axle_spacing_m > v.length_m) {
     n.Fail("bogie_centres_m + axle_spacing_m exceed length_m");
   }
   if (v.axle_spacing_m >= v.bogie_centres_m) {
     n.Fail("axle_spacing_m must be below bogie_centres_m");
   }
-  v.wheel_diameter_m = RangedKey(n, "wheel_diameter_m", v.wheel_diameter_m, 0.5, 1.5);
-  v.body_mass_kg = RangedKey(n, "body_mass_kg", v.body_mass_kg, 5000.0, 80000.0);
-  v.bogie_mass_kg = RangedKey(n, "bogie_mass_kg", v.bogie_mass_kg, 500.0, 10000.0);
-  v.wheelset_mass_kg = RangedKey(n, "wheelset_mass_kg", v.wheelset_mass_kg, 300.0, 5000.0);
-  v.wheelset_inertia_kgm2 = RangedKey(n, "wheelset_inertia_kgm2", v.wheelset_inertia_kgm2, 10.0, 2000.0);
-  v.body_cog_height_m = RangedKey(n, "body_cog_height_m", v.body_cog_height_m, 1.0, 3.0);
-  v.primary_hz = RangedKey(n, "primary_hz", v.primary_hz, 2.0, 15.0);
-  v.primary_damping = RangedKey(n, "primary_damping", v.primary_damping, 0.0, 1.0);
-  v.secondary_hz = RangedKey(n, "secondary_hz", v.secondary_hz, 0.5, 3.0);
-  v.secondary_damping = RangedKey(n, "secondary_damping", v.secondary_damping, 0.0, 1.0);
-  v.roll_coefficient = RangedKey(n, "roll_coefficient", v.roll_coefficient, 0.0, 0.5);
+  ReadOptionalNumbers(n, all.subspan(3, 11));
   if (const auto m = n.OptKey("motored")) {
     const auto arr = m->Array();
     if (arr.size() != kWheelRailAxles) {
@@ -196,20 +227,11 @@ void ParseVehicle(const JsonNode& n, WheelRailScenario& sc) {
       v.motored[i] = arr[i].Bool();
     }
   }
-  v.max_traction_force_n = RangedKey(n, "max_traction_force_n", v.max_traction_force_n, 0.0, 100000.0);
-  v.max_power_w = RangedKey(n, "max_power_w", v.max_power_w, 1000.0, 2e6);
-  v.max_brake_force_n = RangedKey(n, "max_brake_force_n", v.max_brake_force_n, 0.0, 100000.0);
-  v.resistance_a_n = RangedKey(n, "resistance_a_n", v.resistance_a_n, 0.0, 20000.0);
-  v.resistance_b_ns_m = RangedKey(n, "resistance_b_ns_m", v.resistance_b_ns_m, 0.0, 2000.0);
-  v.resistance_c_ns2_m2 = RangedKey(n, "resistance_c_ns2_m2", v.resistance_c_ns2_m2, 0.0, 200.0);
-  v.max_speed_kmh = RangedKey(n, "max_speed_kmh", v.max_speed_kmh, 10.0, 300.0);
+  ReadOptionalNumbers(n, all.subspan(14));
 }
 
 void ParseDriver(const JsonNode& n, WheelRailScenario& sc) {
-  const auto arr = n.Array();
-  if (arr.empty()) {
-    n.Fail("at least one driver command expected");
-  }
+  const auto arr = n.NonEmptyArray("at least one driver command expected");
   for (const auto& e : arr) {
     DriverCommand d;
     const auto tn = e.Key("t_s");
@@ -234,10 +256,10 @@ void ParseDriver(const JsonNode& n, WheelRailScenario& sc) {
 void ParseSlipControl(const JsonNode& n, WheelRailScenario& sc) {
   auto& s = sc.slip_control;
   s.enabled = n.Key("enabled").Bool();
-  s.creep_threshold = RangedKey(n, "creep_threshold", s.creep_threshold, 0.005, 0.5);
-  s.reduce_per_s = RangedKey(n, "reduce_per_s", s.reduce_per_s, 0.01, 100.0);
-  s.recover_per_s = RangedKey(n, "recover_per_s", s.recover_per_s, 0.01, 100.0);
-  s.min_factor = RangedKey(n, "min_factor", s.min_factor, 0.0, 1.0);
+  ReadOptionalNumbers(n, {{"creep_threshold", s.creep_threshold, 0.005, 0.5},
+                          {"reduce_per_s", s.reduce_per_s, 0.01, 100.0},
+                          {"recover_per_s", s.recover_per_s, 0.01, 100.0},
+                          {"min_factor", s.min_factor, 0.0, 1.0}});
 }
 
 void ParseImu(const JsonNode& n, WheelRailScenario& sc) {
@@ -245,12 +267,12 @@ void ParseImu(const JsonNode& n, WheelRailScenario& sc) {
   if (const auto e = n.OptKey("enabled")) {
     m.enabled = e->Bool();
   }
-  m.accel_bias_mps2 = RangedKey(n, "accel_bias_mps2", m.accel_bias_mps2, 0.0, 1.0);
-  m.accel_noise_mps2 = RangedKey(n, "accel_noise_mps2", m.accel_noise_mps2, 0.0, 2.0);
-  m.accel_drift_mps2_per_sqrt_s = RangedKey(n, "accel_drift_mps2_per_sqrt_s", m.accel_drift_mps2_per_sqrt_s, 0.0, 0.01);
-  m.rate_bias_deg_s = RangedKey(n, "rate_bias_deg_s", m.rate_bias_deg_s, 0.0, 1.0);
-  m.rate_noise_deg_s = RangedKey(n, "rate_noise_deg_s", m.rate_noise_deg_s, 0.0, 5.0);
-  m.rate_drift_deg_s_per_sqrt_s = RangedKey(n, "rate_drift_deg_s_per_sqrt_s", m.rate_drift_deg_s_per_sqrt_s, 0.0, 0.01);
+  ReadOptionalNumbers(n, {{"accel_bias_mps2", m.accel_bias_mps2, 0.0, 1.0},
+                          {"accel_noise_mps2", m.accel_noise_mps2, 0.0, 2.0},
+                          {"accel_drift_mps2_per_sqrt_s", m.accel_drift_mps2_per_sqrt_s, 0.0, 0.01},
+                          {"rate_bias_deg_s", m.rate_bias_deg_s, 0.0, 1.0},
+                          {"rate_noise_deg_s", m.rate_noise_deg_s, 0.0, 5.0},
+                          {"rate_drift_deg_s_per_sqrt_s", m.rate_drift_deg_s_per_sqrt_s, 0.0, 0.01}});
 }
 
 void ParseTg(const JsonNode& n, WheelRailScenario& sc) {
@@ -359,8 +381,7 @@ void ParseOdometry(const JsonNode& n, WheelRailScenario& sc) {
 }  // namespace
 
 WheelRailScenario ParseWheelRailScenario(std::string_view text, const std::string& file) {
-  const nlohmann::json doc = JsonNode::Parse(text, file);
-  const JsonNode root(doc, "", file);
+  const JsonDocument root(text, file);
   WheelRailScenario sc;
   sc.file = file;
   const auto schema = root.Key("schema");
@@ -446,8 +467,8 @@ WheelRailScenario ParseWheelRailScenario(std::string_view text, const std::strin
     ParseFaults(*f, sc);
   }
   if (const auto t = root.OptKey("truth")) {
-    sc.truth.event_creep = RangedKey(*t, "event_creep", sc.truth.event_creep, 0.001, 1.0);
-    sc.truth.event_min_s = RangedKey(*t, "event_min_s", sc.truth.event_min_s, 0.0, 60.0);
+    ReadOptionalNumbers(*t, {{"event_creep", sc.truth.event_creep, 0.001, 1.0},
+                             {"event_min_s", sc.truth.event_min_s, 0.0, 60.0}});
   }
   if (const auto o = root.OptKey("odometry")) {
     ParseOdometry(*o, sc);
@@ -456,13 +477,7 @@ WheelRailScenario ParseWheelRailScenario(std::string_view text, const std::strin
 }
 
 WheelRailScenario LoadWheelRailScenario(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    throw offline::InputError(path.string() + ": cannot read");
-  }
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ParseWheelRailScenario(ss.str(), path.string());
+  return ParseWheelRailScenario(offline::ReadInputFile(path, ""), path.string());
 }
 
 }  // namespace railproof::ra::analysis

@@ -22,7 +22,6 @@
 #include <exception>
 #include <filesystem>
 #include <map>
-#include <mutex>
 #include <optional>
 #include <string>
 #include <thread>
@@ -465,13 +464,7 @@ std::string Fmt(const char* f, double v) {
 int Main(int argc, char** argv) {
   const Options o = ParseArgs(argc, argv);
   const auto t0 = std::chrono::steady_clock::now();
-  std::mutex log_mu;
-  const auto progress = [&](const std::string& s) {
-    if (!o.quiet) {
-      const std::lock_guard<std::mutex> lock(log_mu);
-      std::fprintf(stderr, "odometry_study: %s\n", s.c_str());
-    }
-  };
+  const railproof::offline::Progress progress("odometry_study", o.quiet);
 
   // ---- inputs
   std::vector<fs::path> files = ListJson(o.scenarios, "wheel-rail scenarios");
@@ -525,8 +518,7 @@ int Main(int argc, char** argv) {
         studies[i] = an::StudyScenario(sc);
         const an::ScenarioStudy& st = *studies[i];
         railproof::offline::WriteFileAtomic(fs::path(o.out_dir) / (sc.name + ".svg"), an::ScenarioPlotSvg(st));
-        railproof::offline::WriteFileAtomic(fs::path(o.out_dir) / (sc.name + ".events.json"),
-                                        EventsFileJson(st).dump(1) + "\n");
+        railproof::offline::WriteJsonFile(fs::path(o.out_dir) / (sc.name + ".events.json"), EventsFileJson(st));
         if (!o.cycles_dir.empty()) {
           for (const an::StudyRun* r : {&st.primary, &st.single, &st.baseline}) {
             railproof::offline::WriteFileAtomic(fs::path(o.cycles_dir) / (sc.name + "." + r->label + ".csv"),
@@ -744,7 +736,7 @@ int Main(int argc, char** argv) {
          "length",
          "baseline extension (margin_table): the former method's occupied-range growth with the rear bound still "
          "moving (worst case); compare with imu_extension (front + rear margin, permanent)"});
-    railproof::offline::WriteFileAtomic(o.json, j.dump(1) + "\n");
+    railproof::offline::WriteJsonFile(o.json, j);
   }
 
   // ---- summary

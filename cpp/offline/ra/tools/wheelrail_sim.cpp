@@ -54,7 +54,7 @@ int Main(int argc, char** argv) {
     railproof::offline::WriteFileAtomic(o.csv, railproof::ra::analysis::WheelRailCsv(run));
   }
   if (!o.json.empty()) {
-    railproof::offline::WriteFileAtomic(o.json, railproof::ra::analysis::WheelRailJson(sc, run).dump(1) + "\n");
+    railproof::offline::WriteJsonFile(o.json, railproof::ra::analysis::WheelRailJson(sc, run));
   }
   double vmax = 0.0;
   for (const auto& t : run.truth) {

@@ -81,6 +81,24 @@ Content Open(Reader& r) {
   return kind == 1 ? Content::kMessage : Content::kMalformed;
 }
 
+// The message of a payload, read by `read(reader, message)` after the first byte: none for
+// the empty payload, none and `malformed` if it is malformed (read fails, or bytes are left).
+template <typename Message, typename Read>
+std::optional<Message> Decode(std::span<const std::uint8_t> payload, bool& malformed, const Read& read) {
+  Reader r(payload);
+  const Content c = Open(r);
+  malformed = c == Content::kMalformed;
+  if (c != Content::kMessage) {
+    return std::nullopt;
+  }
+  Message m{};
+  if (!read(r, m) || !r.AtEnd()) {
+    malformed = true;
+    return std::nullopt;
+  }
+  return m;
+}
+
 }  // namespace
 
 std::vector<std::uint8_t> EncodePosition(const messages::PositionReport& r) {
@@ -100,22 +118,15 @@ std::vector<std::uint8_t> EncodePosition(const messages::PositionReport& r) {
 std::vector<std::uint8_t> EncodeNoPosition() { return {0}; }
 
 std::optional<messages::PositionReport> DecodePosition(std::span<const std::uint8_t> payload, bool& malformed) {
-  Reader r(payload);
-  const Content c = Open(r);
-  malformed = c == Content::kMalformed;
-  if (c != Content::kMessage) {
-    return std::nullopt;
-  }
-  messages::PositionReport rep{};
-  std::uint8_t dir = 0;
-  if (!r.U32(rep.train_id) || !r.U32(rep.front_block) || !r.I64(rep.offset_mm) ||
-      !r.I64(rep.length_mm) || !r.I64(rep.correction_mm) || !r.I64(rep.last_balise_mm) || !r.I64(rep.speed_mm_s) ||
-      !r.U8(dir) || !r.AtEnd() || dir > 1) {
-    malformed = true;
-    return std::nullopt;
-  }
-  rep.direction = dir == 0 ? mb::wayside::Direction::kNominal : mb::wayside::Direction::kReverse;
-  return rep;
+  return Decode<messages::PositionReport>(payload, malformed, [](Reader& r, messages::PositionReport& rep) {
+    std::uint8_t dir = 0;
+    if (!r.U32(rep.train_id) || !r.U32(rep.front_block) || !r.I64(rep.offset_mm) || !r.I64(rep.length_mm) ||
+        !r.I64(rep.correction_mm) || !r.I64(rep.last_balise_mm) || !r.I64(rep.speed_mm_s) || !r.U8(dir) || dir > 1) {
+      return false;
+    }
+    rep.direction = dir == 0 ? mb::wayside::Direction::kNominal : mb::wayside::Direction::kReverse;
+    return true;
+  });
 }
 
 std::vector<std::uint8_t> EncodeStopLimit(const messages::StopLimitTelegram& t) {
@@ -143,40 +154,29 @@ std::vector<std::uint8_t> EncodeStopLimit(const messages::StopLimitTelegram& t) 
 std::vector<std::uint8_t> EncodeKeepAlive() { return {0}; }
 
 std::optional<messages::StopLimitTelegram> DecodeStopLimit(std::span<const std::uint8_t> payload, bool& malformed) {
-  Reader r(payload);
-  const Content c = Open(r);
-  malformed = c == Content::kMalformed;
-  if (c != Content::kMessage) {
-    return std::nullopt;
-  }
-  messages::StopLimitTelegram t{};
-  std::uint8_t obstruction = 0;
-  std::uint8_t n = 0;
-  std::uint8_t truncated = 0;
-  if (!r.U32(t.train_id) || !r.I64(t.limit_mm) || !r.U8(obstruction) || !r.I64(t.issue_time_ms) ||
-      !r.U8(n) || !r.U8(truncated) || n > kControlRestrictionsMax || obstruction > 8 || truncated > 1) {
-    malformed = true;
-    return std::nullopt;
-  }
-  t.kind = static_cast<messages::Obstruction>(obstruction);
-  t.restriction_count = n;
-  t.restrictions_truncated = truncated != 0;
-  for (std::size_t i = 0; i < n; ++i) {
-    std::uint32_t id = 0;
-    std::uint32_t b = 0;
-    std::uint32_t e = 0;
-    std::uint32_t s = 0;
-    if (!r.U32(id) || !r.U32(b) || !r.U32(e) || !r.U32(s)) {
-      malformed = true;
-      return std::nullopt;
+  return Decode<messages::StopLimitTelegram>(payload, malformed, [](Reader& r, messages::StopLimitTelegram& t) {
+    std::uint8_t obstruction = 0;
+    std::uint8_t n = 0;
+    std::uint8_t truncated = 0;
+    if (!r.U32(t.train_id) || !r.I64(t.limit_mm) || !r.U8(obstruction) || !r.I64(t.issue_time_ms) || !r.U8(n) ||
+        !r.U8(truncated) || n > kControlRestrictionsMax || obstruction > 8 || truncated > 1) {
+      return false;
     }
-    t.restrictions[i] = messages::SpeedRestriction{id, static_cast<std::int32_t>(b), static_cast<std::int32_t>(e), s};
-  }
-  if (!r.AtEnd()) {
-    malformed = true;
-    return std::nullopt;
-  }
-  return t;
+    t.kind = static_cast<messages::Obstruction>(obstruction);
+    t.restriction_count = n;
+    t.restrictions_truncated = truncated != 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      std::uint32_t id = 0;
+      std::uint32_t b = 0;
+      std::uint32_t e = 0;
+      std::uint32_t s = 0;
+      if (!r.U32(id) || !r.U32(b) || !r.U32(e) || !r.U32(s)) {
+        return false;
+      }
+      t.restrictions[i] = messages::SpeedRestriction{id, static_cast<std::int32_t>(b), static_cast<std::int32_t>(e), s};
+    }
+    return true;
+  });
 }
 
 }  // namespace railproof::sim

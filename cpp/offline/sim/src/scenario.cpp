@@ -10,7 +10,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <fstream>
 #include <limits>
 #include <set>
 #include <sstream>
@@ -129,46 +128,44 @@ TrainSpec ReadTrain(const JsonNode& n, const std::string& entry) {
   return t;
 }
 
+FaultType ReadFaultType(const JsonNode& n) {
+  const std::string type = n.String();
+  for (const FaultType t : {FaultType::kRadioLoss, FaultType::kTrackingLoss, FaultType::kPossession,
+                            FaultType::kSidingRequest, FaultType::kSpeedRestriction}) {
+    if (type == ToString(t)) {
+      return t;
+    }
+  }
+  n.Fail("unknown fault type '" + type + "' (radio_loss, tracking_loss, possession, siding_request, speed_restriction)");
+}
+
 FaultSpec ReadFault(const JsonNode& n, const std::string& entry) {
   FaultSpec f;
   f.entry = entry;
-  const JsonNode tn = n.Key("type");
-  const std::string type = tn.String();
-  if (type == "radio_loss" || type == "tracking_loss") {
-    f.type = type == "radio_loss" ? FaultType::kRadioLoss : FaultType::kTrackingLoss;
+  f.type = ReadFaultType(n.Key("type"));
+  if (f.type == FaultType::kRadioLoss || f.type == FaultType::kTrackingLoss) {
     const JsonNode trn = n.Key("train");
     const std::int64_t id = trn.Int();
     if (id < 0 || id > 0xFFFF) {
       trn.Fail("train id out of range 0..65535");
     }
     f.train = static_cast<std::uint16_t>(id);
-  } else if (type == "possession") {
-    f.type = FaultType::kPossession;
+  } else if (f.type == FaultType::kPossession || f.type == FaultType::kSpeedRestriction) {
+    const bool possession = f.type == FaultType::kPossession;
     f.begin_mm = MetresToMm(NonNegative(n.Key("begin_m")));
     const JsonNode en = n.Key("end_m");
     f.end_mm = MetresToMm(NonNegative(en));
     if (f.end_mm <= f.begin_mm) {
-      en.Fail("possession end not after its begin");
+      en.Fail(std::string(possession ? "possession" : "restriction") + " end not after its begin");
     }
-  } else if (type == "speed_restriction") {
-    f.type = FaultType::kSpeedRestriction;
-    f.begin_mm = MetresToMm(NonNegative(n.Key("begin_m")));
-    const JsonNode en = n.Key("end_m");
-    f.end_mm = MetresToMm(NonNegative(en));
-    if (f.end_mm <= f.begin_mm) {
-      en.Fail("restriction end not after its begin");
+    if (!possession) {
+      f.speed_mps = Positive(n.Key("speed_kmh"), 400.0) / 3.6;
     }
-    f.speed_mps = Positive(n.Key("speed_kmh"), 400.0) / 3.6;
-  } else if (type == "siding_request") {
-    f.type = FaultType::kSidingRequest;
-    if (auto r = n.OptKey("route")) {
-      f.route = r->Int();
-      if (f.route <= 0) {
-        r->Fail("route id must be positive");
-      }
+  } else if (auto r = n.OptKey("route")) {  // a siding request naming its route
+    f.route = r->Int();
+    if (f.route <= 0) {
+      r->Fail("route id must be positive");
     }
-  } else {
-    tn.Fail("unknown fault type '" + type + "' (radio_loss, tracking_loss, possession, siding_request, speed_restriction)");
   }
   const JsonNode fn = n.Key("from_s");
   f.from_ms = SecondsToMs(fn, NonNegative(fn));
@@ -183,14 +180,9 @@ FaultSpec ReadFault(const JsonNode& n, const std::string& entry) {
 }  // namespace
 
 Scenario ParseScenario(std::string_view text, const std::string& file) {
-  const nlohmann::json doc = JsonNode::Parse(text, file);
-  const JsonNode root(doc, "", file);
+  const JsonDocument root(text, file, kScenarioSchema);
   Scenario sc;
   sc.file = file;
-  const JsonNode schema = root.Key("schema");
-  if (schema.String() != kScenarioSchema) {
-    schema.Fail("unsupported schema '" + schema.String() + "', expected '" + std::string(kScenarioSchema) + "'");
-  }
   sc.name = root.Key("name").String();
   if (auto d = root.OptKey("description")) {
     sc.description = d->String();
@@ -278,13 +270,8 @@ Scenario ParseScenario(std::string_view text, const std::string& file) {
   }
 
   {
-    const JsonNode tn = root.Key("trains");
-    const auto nodes = tn.Array();
-    if (nodes.empty()) {
-      tn.Fail("no train");
-    }
     std::set<std::uint16_t> ids;
-    for (const auto& n : nodes) {
+    for (const auto& n : root.Key("trains").NonEmptyArray("no train")) {
       const TrainSpec base = ReadTrain(n, n.Path());
       std::int64_t count = 1;
       double interval_s = 0.0;
@@ -351,13 +338,7 @@ Scenario ParseScenario(std::string_view text, const std::string& file) {
 }
 
 Scenario LoadScenario(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    throw InputError(path.string() + ": cannot read scenario file");
-  }
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ParseScenario(ss.str(), path.string());
+  return ParseScenario(ReadInputFile(path, "scenario file"), path.string());
 }
 
 const RunningLine& SelectRunningLine(const Scenario& sc, const Line& line) {

@@ -105,6 +105,16 @@ const TrainRt* Simulation::Impl::Find(std::uint16_t id) const {
   return nullptr;
 }
 
+std::vector<TrainRt*> Simulation::Impl::TrainsOnLine() const {
+  std::vector<TrainRt*> on;
+  for (const auto& t : trains) {
+    if (t->OnLine()) {
+      on.push_back(t.get());
+    }
+  }
+  return on;
+}
+
 bool Simulation::Impl::Step() {
   if (now >= sc.duration_ms) {
     return false;

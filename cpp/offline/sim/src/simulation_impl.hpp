@@ -226,6 +226,8 @@ struct Simulation::Impl {
   void Violate(const std::string& req, const std::string& key, const std::string& detail);
   TrainRt* Find(std::uint16_t id);
   [[nodiscard]] const TrainRt* Find(std::uint16_t id) const;
+  // The trains on the line (entered and not left), in the scenario's order.
+  [[nodiscard]] std::vector<TrainRt*> TrainsOnLine() const;
   bool Step();
 
   // ---- scheduled commands and fault windows (simulation_schedule.cpp)

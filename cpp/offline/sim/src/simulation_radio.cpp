@@ -125,10 +125,7 @@ std::pair<std::uint32_t, std::int64_t> Simulation::Impl::Locate(std::int64_t fro
 
 void Simulation::Impl::GroundCycle() {
   // radio channel management: secure the handovers ahead of every tracked train
-  for (auto& t : trains) {
-    if (!t->OnLine()) {
-      continue;
-    }
+  for (TrainRt* t : TrainsOnLine()) {
     const auto ext = ground->Extended(t->spec.id);
     if (!ext) {
       continue;
@@ -186,10 +183,7 @@ void Simulation::Impl::GroundCycle() {
     tgs[tg.train_id] = &tg;
   }
   Json cyc = Json::array();
-  for (auto& t : trains) {
-    if (!t->OnLine()) {
-      continue;
-    }
+  for (TrainRt* t : TrainsOnLine()) {
     const auto o = ground->Train(t->spec.id);
     if (!o) {
       continue;

@@ -239,15 +239,14 @@ TEST(SimScenarioFile, EveryProvidedScenarioParses) {
 // ---- payload codec ---------------------------------------------------------------------
 
 TEST(SimCodec, PositionAndStopLimitPayloadsRoundTrip) {
-  messages::PositionReport r{};
-  r.train_id = 7;
-  r.front_block = 12;
-  r.offset_mm = 34'567;
-  r.length_mm = 100'000;
-  r.correction_mm = 321;
-  r.last_balise_mm = 250'000;
-  r.speed_mm_s = 27'777;
-  r.direction = mb::wayside::Direction::kNominal;
+  const messages::PositionReport r{.train_id = 7,
+                                   .front_block = 12,
+                                   .offset_mm = 34'567,
+                                   .length_mm = 100'000,
+                                   .correction_mm = 321,
+                                   .last_balise_mm = 250'000,
+                                   .speed_mm_s = 27'777,
+                                   .direction = mb::wayside::Direction::kNominal};
   bool malformed = true;
   const auto back = DecodePosition(EncodePosition(r), malformed);
   ASSERT_TRUE(back.has_value());

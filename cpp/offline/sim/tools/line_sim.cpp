@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iostream>
 #include <string>
 #include <vector>
@@ -104,11 +105,7 @@ int Main(int argc, char** argv) {
   const Options o = ParseArgs(argc, argv);
   const auto base = railproof::sim::LoadScenario(o.scenario);
   const auto line = railproof::offline::LoadLine(railproof::offline::LinePath(o.lines_dir, base.line));
-  auto progress = [&](const std::string& line_text) {
-    if (!o.quiet) {
-      std::fprintf(stderr, "line_sim: %s\n", line_text.c_str());
-    }
-  };
+  const railproof::offline::Progress progress("line_sim", o.quiet);
 
   if (!o.sweep.empty()) {
     Json runs = Json::array();
@@ -121,7 +118,7 @@ int Main(int argc, char** argv) {
       railproof::sim::Simulation sim(sc, line);
       const auto t0 = std::chrono::steady_clock::now();
       railproof::sim::RunOptions ro;
-      ro.progress = progress;
+      ro.progress = std::cref(progress);
       sim.Run(ro);
       const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
       const Json s = sim.Summary();
@@ -142,7 +139,7 @@ int Main(int argc, char** argv) {
              {"result", all_pass ? "PASS" : "FAIL"}};
     std::printf("gap grows with the leader's speed: %s\n", grows ? "yes" : "no");
     if (!o.summary.empty()) {
-      railproof::offline::WriteFileAtomic(o.summary, out.dump(1) + "\n");
+      railproof::offline::WriteJsonFile(o.summary, out);
     }
     return all_pass ? 0 : 1;
   }
@@ -155,7 +152,7 @@ int Main(int argc, char** argv) {
   std::ofstream log;
   std::string log_tmp;
   railproof::sim::RunOptions ro;
-  ro.progress = progress;
+  ro.progress = std::cref(progress);
   ro.log_full = o.log_full;
   if (!o.log.empty()) {
     log_tmp = o.log + ".tmp";
@@ -177,7 +174,7 @@ int Main(int argc, char** argv) {
   }
   const Json s = sim.Summary();
   if (!o.summary.empty()) {
-    railproof::offline::WriteFileAtomic(o.summary, s.dump(1) + "\n");
+    railproof::offline::WriteJsonFile(o.summary, s);
   }
   if (!o.svg.empty()) {
     railproof::offline::WriteFileAtomic(o.svg, sim.Svg());

@@ -14,23 +14,9 @@
 #include "railproof/tg/analysis/residual_error.hpp"
 #include "railproof/tg/reed_solomon.hpp"
 
+namespace railproof::tg::analysis {
 namespace {
 
-using railproof::tg::analysis::Binomial;
-using railproof::tg::analysis::BlockOutcome;
-using railproof::tg::analysis::BlockOutcomeForSymbolErrorProbability;
-using railproof::tg::analysis::CodeSpec;
-using railproof::tg::analysis::ComputeResidual;
-using railproof::tg::analysis::CountsByErrorWeight;
-using railproof::tg::analysis::MdsWeightDistribution;
-using railproof::tg::analysis::ResidualConfig;
-using railproof::tg::analysis::ResidualReportJson;
-using railproof::tg::analysis::ResidualReportTable;
-using railproof::tg::analysis::SphereCount;
-using railproof::tg::analysis::SymbolErrorProbability;
-using railproof::tg::ReedSolomon;
-using railproof::tg::RsParams;
-using railproof::tg::RsStatus;
 using Bytes = std::vector<std::uint8_t>;
 
 // The design point: RS(66,50) over GF(2^8), 4 blocks, 9600 bit/s, target 1e-9 per hour,
@@ -70,6 +56,26 @@ unsigned Weight(const Bytes& w) {
   return h;
 }
 
+// Calls `visit(word)` for every word of `length` symbols over GF(2^m), in the order of its
+// value in base 2^m (first symbol least significant).
+template <typename Visit>
+void ForEveryWord(unsigned m, unsigned length, const Visit& visit) {
+  const unsigned q = 1U << m;
+  unsigned long long words = 1;
+  for (unsigned i = 0; i < length; ++i) {
+    words *= q;
+  }
+  Bytes w(length);
+  for (unsigned long long v = 0; v < words; ++v) {
+    unsigned long long x = v;
+    for (unsigned i = 0; i < length; ++i) {
+      w[i] = static_cast<std::uint8_t>(x % q);
+      x /= q;
+    }
+    visit(w);
+  }
+}
+
 // ---- weight distribution ---------------------------------------------------------------
 
 // @verifies REQ-TG-019
@@ -107,23 +113,12 @@ TEST(ResidualError, WeightDistributionMatchesBruteForceEnumeration) {
   for (const CodeSpec& c : codes) {
     const ReedSolomon rs = MakeCode(c);
     ASSERT_TRUE(rs.valid());
-    const unsigned q = 1U << c.m;
     std::vector<unsigned long long> counted(c.n + 1U, 0);
-    unsigned long long messages = 1;
-    for (unsigned i = 0; i < c.k; ++i) {
-      messages *= q;
-    }
-    Bytes msg(c.k);
     Bytes cw(c.n);
-    for (unsigned long long v = 0; v < messages; ++v) {
-      unsigned long long x = v;
-      for (unsigned i = 0; i < c.k; ++i) {
-        msg[i] = static_cast<std::uint8_t>(x % q);
-        x /= q;
-      }
+    ForEveryWord(c.m, c.k, [&](const Bytes& msg) {
       ASSERT_EQ(rs.Encode(msg, cw), RsStatus::kOk);
       ++counted[Weight(cw)];
-    }
+    });
     const auto a = MdsWeightDistribution(c);
     for (unsigned w = 0; w <= c.n; ++w) {
       EXPECT_EQ(static_cast<unsigned long long>(std::llround(a[w])), counted[w])
@@ -145,21 +140,10 @@ TEST(ResidualError, OutcomeCountsMatchExhaustiveDecoding) {
   for (const CodeSpec& c : codes) {
     const ReedSolomon rs = MakeCode(c);
     ASSERT_TRUE(rs.valid());
-    const unsigned q = 1U << c.m;
     std::vector<unsigned long long> correct(c.n + 1U, 0);
     std::vector<unsigned long long> mis(c.n + 1U, 0);
     std::vector<unsigned long long> detected(c.n + 1U, 0);
-    unsigned long long words = 1;
-    for (unsigned i = 0; i < c.n; ++i) {
-      words *= q;
-    }
-    Bytes w(c.n);
-    for (unsigned long long v = 0; v < words; ++v) {
-      unsigned long long x = v;
-      for (unsigned i = 0; i < c.n; ++i) {
-        w[i] = static_cast<std::uint8_t>(x % q);
-        x /= q;
-      }
+    ForEveryWord(c.m, c.n, [&](Bytes& w) {
       const unsigned h = Weight(w);
       const auto r = rs.Decode(w);
       if (r.status == RsStatus::kUncorrectable) {
@@ -169,7 +153,7 @@ TEST(ResidualError, OutcomeCountsMatchExhaustiveDecoding) {
       } else {
         ++mis[h];
       }
-    }
+    });
     const auto counts = CountsByErrorWeight(c);
     ASSERT_EQ(counts.size(), c.n + 1U);
     for (unsigned h = 0; h <= c.n; ++h) {
@@ -433,3 +417,4 @@ TEST(ResidualError, ReadableTable) {
 }
 
 }  // namespace
+}  // namespace railproof::tg::analysis

@@ -19,6 +19,7 @@
 
 #include <functional>
 #include <limits>
+#include <mutex>
 #include <string>
 #include <type_traits>
 #include <utility>
@@ -108,6 +109,19 @@ CLI::Option* Cli::Add(const std::string& name, T& target, const std::string& hel
 CLI::Validator InRange(double lo, double hi, bool lo_open = false);
 // A number above `lo` (lo < value); message "not a number above lo: 'text'".
 CLI::Validator Above(double lo);
+
+// The progress lines of a tool on stderr, "<tool>: <text>", none if `quiet` (--quiet); one
+// line at a time when called from several threads.
+class Progress {
+ public:
+  Progress(std::string tool, bool quiet) : tool_(std::move(tool)), quiet_(quiet) {}
+  void operator()(const std::string& text) const;
+
+ private:
+  std::string tool_;
+  bool quiet_;
+  mutable std::mutex mu_;
+};
 
 // The main() of a tool: runs `body` and returns its exit status; an InputError prints
 // "<tool>: <what>", any other std::exception "<tool>: error: <what>" on stderr, exit 2.

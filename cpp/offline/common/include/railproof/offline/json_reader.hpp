@@ -1,10 +1,12 @@
-// Typed, path-aware access to a parsed JSON document for the simulation's input files:
+// Typed, path-aware access to a parsed JSON document for the offline tools' input files:
 // every failure throws InputError "<file>: <entry path>: <reason>" (one line), so the
 // message names the entry (REQ-MB-020), e.g. "d1.json: running_lines[0] (up).blocks_mm[3]:
-// expected an integer, got string".
+// expected an integer, got string". JsonDocument and ReadInputFile are what every input
+// loader shares: the file read, the parse and the schema check.
 #pragma once
 
 #include <cstdint>
+#include <filesystem>
 #include <initializer_list>
 #include <optional>
 #include <string>
@@ -43,6 +45,8 @@ class JsonNode {
   [[nodiscard]] std::string String() const;
   [[nodiscard]] bool Bool() const;
   [[nodiscard]] std::vector<JsonNode> Array() const;
+  // The elements of an array that must not be empty (`if_empty`: the reason if it is).
+  [[nodiscard]] std::vector<JsonNode> NonEmptyArray(const std::string& if_empty) const;
 
   // The same node with a label appended to its path (e.g. the id of an array element).
   [[nodiscard]] JsonNode Labelled(const std::string& label) const;
@@ -50,6 +54,8 @@ class JsonNode {
   [[noreturn]] void Fail(const std::string& reason) const;
 
  private:
+  // Fails with "expected <what>, got <type>" unless `is_expected`.
+  void RequireType(bool is_expected, std::string_view what) const;
   void RequireObject() const;
 
   const nlohmann::json* value_;
@@ -59,5 +65,28 @@ class JsonNode {
 
 // "<what> (<type name>)" for messages.
 std::string JsonTypeName(const nlohmann::json& value);
+
+namespace json_detail {
+// The parsed document, a base of JsonDocument so that it is built before the root node.
+struct ParsedJson {
+  nlohmann::json doc;
+};
+}  // namespace json_detail
+
+// A parsed input document, which is its own root node (path ""): the text of `file` is
+// parsed ("<file>: invalid JSON: <parser message>" on a syntax error) and, given `schema`,
+// its "schema" member must equal it ("<file>: schema: unsupported schema '<found>', expected
+// '<schema>'<note>"). `file` must outlive the document and every node taken from it.
+class JsonDocument : private json_detail::ParsedJson, public JsonNode {
+ public:
+  JsonDocument(std::string_view text, const std::string& file);
+  JsonDocument(std::string_view text, const std::string& file, std::string_view schema, std::string_view note = "");
+  JsonDocument(const JsonDocument&) = delete;
+  JsonDocument& operator=(const JsonDocument&) = delete;
+};
+
+// The whole text of an input file; "<path>: cannot read <what>" ("<path>: cannot read" if
+// `what` is empty) when it cannot be opened.
+std::string ReadInputFile(const std::filesystem::path& path, std::string_view what);
 
 }  // namespace railproof::offline

@@ -30,4 +30,11 @@ inline void WriteFileAtomic(const std::filesystem::path& path, const std::string
   }
 }
 
+// A result JSON file of an offline tool (nlohmann::json or ordered_json), written atomically
+// in the tools' one format: indented by one space, ending with a newline.
+template <typename Json>
+void WriteJsonFile(const std::filesystem::path& path, const Json& json) {
+  WriteFileAtomic(path, json.dump(1) + "\n");
+}
+
 }  // namespace railproof::offline
