@@ -97,17 +97,10 @@ class StepChecker {
 };
 
 rr::EndpointConfig ConfigFor(const rc::FileHeader& h, rr::Role role) {
-  rr::EndpointConfig c{};
+  rr::EndpointConfig c = h.endpoint;
   c.role = role;
   c.own_id = role == rr::Role::kGround ? h.ground_id : h.train_id;
   c.peer_id = role == rr::Role::kGround ? h.train_id : h.ground_id;
-  c.seq_modulus = h.seq_modulus;
-  c.seq_window = h.seq_window;
-  c.history_depth = h.history_depth;
-  c.turnaround_ms = h.turnaround_ms;
-  c.link_timeout_ms = h.link_timeout_ms;
-  c.echo_validity_ms = h.echo_validity_ms;
-  c.initial_seq = h.init_own_seq;
   return c;
 }
 
