@@ -85,6 +85,31 @@ std::unique_ptr<Odometry> Make() {
   return od;
 }
 
+// Steps od through the stream up to its first detection cycle and returns that cycle's index
+// (0: none); with `before`, od is left in the state before the detection cycle.
+std::size_t StepToDetection(Odometry& od, const std::vector<CycleInput>& stream, bool before) {
+  for (std::size_t k = 0; k < stream.size(); ++k) {
+    const Odometry previous(od);
+    if (od.Step(stream[k]).detected) {
+      if (before) {
+        od = previous;
+      }
+      return k;
+    }
+  }
+  return 0;
+}
+
+// One Step timed by hand (the benchmarks below use manual time); its output.
+const OdometryOutput& TimedStep(benchmark::State& state, Odometry& od, const CycleInput& in) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const OdometryOutput& o = od.Step(in);
+  benchmark::DoNotOptimize(o);
+  const auto t1 = std::chrono::steady_clock::now();
+  state.SetIterationTime(std::chrono::duration<double>(t1 - t0).count());
+  return o;
+}
+
 // TG odometry: every cycle of a 4096-cycle stream without slip (re-created at its end).
 void BM_OdometryStepTg(benchmark::State& state) {
   const auto stream = MakeStream(4'096, 1'000'000, false);
@@ -110,13 +135,7 @@ BENCHMARK(BM_OdometryStepTg);
 void BM_OdometryStepCompensatingTwoCandidates(benchmark::State& state) {
   const auto stream = MakeStream(400, 200, false);
   auto od = Make();
-  std::size_t d = 0;
-  for (std::size_t k = 0; k < stream.size(); ++k) {
-    if (od->Step(stream[k]).detected) {
-      d = k;
-      break;
-    }
-  }
+  const std::size_t d = StepToDetection(*od, stream, false);
   if (d == 0) {
     state.SkipWithError("no detection");
     return;
@@ -129,10 +148,7 @@ void BM_OdometryStepCompensatingTwoCandidates(benchmark::State& state) {
       *od = *snapshot;
       i = d + 1;
     }
-    const auto t0 = std::chrono::steady_clock::now();
-    benchmark::DoNotOptimize(od->Step(stream[i]));
-    const auto t1 = std::chrono::steady_clock::now();
-    state.SetIterationTime(std::chrono::duration<double>(t1 - t0).count());
+    TimedStep(state, *od, stream[i]);
     ++i;
   }
   state.SetLabel("two candidates active");
@@ -143,15 +159,7 @@ BENCHMARK(BM_OdometryStepCompensatingTwoCandidates)->UseManualTime();
 void BM_OdometryStepDetectionWorstCase(benchmark::State& state) {
   const auto stream = MakeStream(300, 200, true);
   auto od = Make();
-  std::size_t d = 0;
-  for (std::size_t k = 0; k < stream.size(); ++k) {
-    Odometry before(*od);
-    if (od->Step(stream[k]).detected) {
-      d = k;
-      *od = before;
-      break;
-    }
-  }
+  const std::size_t d = StepToDetection(*od, stream, true);
   if (d == 0) {
     state.SkipWithError("no detection");
     return;
@@ -160,12 +168,7 @@ void BM_OdometryStepDetectionWorstCase(benchmark::State& state) {
   std::int32_t age = 0;
   for (auto _ : state) {
     *od = *snapshot;
-    const auto t0 = std::chrono::steady_clock::now();
-    const auto& o = od->Step(stream[d]);
-    benchmark::DoNotOptimize(o);
-    const auto t1 = std::chrono::steady_clock::now();
-    state.SetIterationTime(std::chrono::duration<double>(t1 - t0).count());
-    age = o.start_age_cycles;
+    age = TimedStep(state, *od, stream[d]).start_age_cycles;
   }
   if (age != 75) state.SkipWithError("not the deepest catch-up");
   state.SetLabel("catch-up 75 + 100 cycles");
