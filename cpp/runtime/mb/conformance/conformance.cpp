@@ -33,6 +33,7 @@
 #include "railproof/mb/onboard/authority.hpp"
 #include "railproof/mb/wayside/ground.hpp"
 #include "railproof/testing/jsonl_runner.hpp"
+#include "../tests/line_data.hpp"
 
 namespace rcli = railproof::conformance;
 
@@ -41,6 +42,7 @@ namespace {
 namespace rw = railproof::mb::wayside;
 namespace ro = railproof::mb::onboard;
 using json = nlohmann::json;
+using railproof::mb::wayside::test::LineData;
 
 constexpr std::uint32_t kMainRouteId = 1;
 constexpr std::uint32_t kSidingRouteId = 2;
@@ -68,22 +70,14 @@ std::string ReadHeader(const std::string& file, const json& obj) {
   return "";
 }
 
-// The model's line as a ground configuration (design note §2 mapping).
-struct LineData {
-  std::vector<std::int64_t> blocks;
-  std::vector<rw::Section> fixed;
-  std::vector<rw::PointsConfig> points;
-  std::vector<rw::RouteConfig> routes;
-  std::vector<rw::HandoverConfig> handovers;
-  rw::LineConfig line{};
-};
-
 rw::Section SectionOf(const json& a) { return rw::Section{a.at(0).get<std::int64_t>(), a.at(1).get<std::int64_t>()}; }
 
+// The model's line as a ground configuration (design note §2 mapping).
 void BuildLine(const Header& h, LineData& d) {
   const json& p = h.p;
   d.blocks = p.at("blocks_mm").get<std::vector<std::int64_t>>();
   d.fixed = {SectionOf(p.at("platform_mm"))};
+  d.setback = d.fixed;  // the platform is the set-back section
   d.points = {rw::PointsConfig{1, SectionOf(p.at("points_mm"))}};
   const rw::Section main = SectionOf(p.at("route_main_mm"));
   const rw::Section pts = SectionOf(p.at("points_mm"));
@@ -91,17 +85,9 @@ void BuildLine(const Header& h, LineData& d) {
               rw::RouteConfig{kSidingRouteId, pts.begin_mm, pts.end_mm, 0, true, false}};
   d.handovers = {rw::HandoverConfig{kHandoverId, p.at("handover_mm").get<std::int64_t>()}};
   const json& m = p.at("margins_mm");
-  rw::LineConfig& l = d.line;
-  l = rw::DefaultLineParameters();
+  d.boundary = p.at("boundary_mm").get<std::int64_t>();
+  rw::LineConfig& l = d.base;
   l.length_mm = p.at("line_mm").get<std::int64_t>();
-  l.blocks_mm = d.blocks;
-  l.fixed_blocks = d.fixed;
-  l.setback_sections = d.fixed;  // the platform is the set-back section
-  l.no_stop_sections = {};
-  l.points = d.points;
-  l.routes = d.routes;
-  l.handovers = d.handovers;
-  l.system_boundary_mm = p.at("boundary_mm").get<std::int64_t>();
   l.margins = rw::Margins{m.at("train").get<std::int64_t>(),    m.at("fixed_block").get<std::int64_t>(),
                           m.at("route").get<std::int64_t>(),    m.at("handover").get<std::int64_t>(),
                           m.at("boundary").get<std::int64_t>(), m.at("possession").get<std::int64_t>(),
@@ -134,7 +120,7 @@ void Replay(const rcli::JsonVector& v, std::vector<std::string>& problems) {
   rw::Capacity cap = rw::DefaultCapacity();
   cap.trains = fronts.size();
   cap.blocks = d.blocks.size() - 1;
-  auto created = rw::Ground::Create(d.line, cap, 0);
+  auto created = rw::Ground::Create(d.Config(), cap, 0);
   if (created.error != rw::ConfigError::kNone) {
     problems.push_back(std::string("ground configuration refused: ") + ToString(created.error) +
                        " entry " + std::to_string(created.entry));

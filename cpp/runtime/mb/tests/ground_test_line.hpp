@@ -13,6 +13,7 @@
 #include <utility>
 #include <vector>
 
+#include "line_data.hpp"
 #include "railproof/mb/wayside/ground.hpp"
 
 namespace railproof::mb::wayside::test {
@@ -23,18 +24,8 @@ inline constexpr std::int64_t kTrainLen = 100'000;
 inline constexpr Margins kMargins{20'000, 21'000, 30'000, 22'000, 23'000, 50'000, 40'000, 10'000};
 inline constexpr std::int64_t kEot = kLen - 10'000;  // END_OF_TRACK limit
 
-struct TestLine {
-  std::vector<std::int64_t> blocks;
-  std::vector<Section> fixed;
-  std::vector<Section> setback;
-  std::vector<Section> no_stop;
-  std::vector<PointsConfig> points;
-  std::vector<RouteConfig> routes;
-  std::vector<HandoverConfig> handovers;
-  std::optional<std::int64_t> boundary;
-  LineConfig base;
-
-  TestLine() : base(DefaultLineParameters()) {
+struct TestLine : LineData {
+  TestLine() {
     base.length_mm = kLen;
     base.margins = kMargins;
     for (std::int64_t x = 0; x <= kLen; x += kBlock) {
@@ -49,19 +40,6 @@ struct TestLine {
     routes.push_back(RouteConfig{1, 1'000'000, 1'100'000, 0, false, true});
     routes.push_back(RouteConfig{2, 1'000'000, 1'100'000, 0, true, false});
     return *this;
-  }
-
-  [[nodiscard]] LineConfig Config() const {
-    LineConfig c = base;
-    c.blocks_mm = blocks;
-    c.fixed_blocks = fixed;
-    c.setback_sections = setback;
-    c.no_stop_sections = no_stop;
-    c.points = points;
-    c.routes = routes;
-    c.handovers = handovers;
-    c.system_boundary_mm = boundary;
-    return c;
   }
 };
 
