@@ -8,8 +8,11 @@
 #include <gtest/gtest.h>
 
 #include <cstdint>
+#include <initializer_list>
 #include <memory>
 #include <optional>
+#include <ostream>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -69,6 +72,16 @@ inline RegisterStatus Register(Ground& g, std::uint32_t id, std::int64_t front, 
   return g.RegisterTrain(TrainRegistration{id, length, front, corr, initial});
 }
 
+// A ground over `line` with the trains (id, front) registered at their entry balise, in order.
+inline std::unique_ptr<Ground> MakeGround(const TestLine& line,
+                                          std::initializer_list<std::pair<std::uint32_t, std::int64_t>> trains) {
+  auto g = MakeGround(line);
+  for (const auto& [id, front] : trains) {
+    EXPECT_EQ(Register(*g, id, front), RegisterStatus::kRegistered) << "train " << id;
+  }
+  return g;
+}
+
 inline PositionReport MakeReport(const Ground& g, std::uint32_t id, std::int64_t front, std::int64_t corr = 0,
                                  std::int64_t length = kTrainLen) {
   const auto pos = g.LocateFront(front);
@@ -90,6 +103,19 @@ inline Obstruction KindOf(const Ground& g, std::uint32_t id) {
   const auto t = g.Train(id);
   return t.has_value() ? t->kind : Obstruction::kNone;
 }
+
+// A train's stop limit and what limits it, compared and printed together.
+struct LimitAndKind {
+  std::optional<std::int64_t> limit_mm;
+  Obstruction kind = Obstruction::kNone;
+  bool operator==(const LimitAndKind&) const = default;
+};
+
+inline void PrintTo(const LimitAndKind& l, std::ostream* os) {
+  *os << (l.limit_mm ? std::to_string(*l.limit_mm) : std::string("no limit")) << " (" << ToString(l.kind) << ")";
+}
+
+inline LimitAndKind LimitAndKindOf(const Ground& g, std::uint32_t id) { return {LimitOf(g, id), KindOf(g, id)}; }
 
 inline bool AbnormalOf(const Ground& g, std::uint32_t id) {
   const auto t = g.Train(id);
