@@ -85,19 +85,26 @@ std::unique_ptr<Odometry> Make() {
   return od;
 }
 
-// Steps od through the stream up to its first detection cycle and returns that cycle's index
-// (0: none); with `before`, od is left in the state before the detection cycle.
-std::size_t StepToDetection(Odometry& od, const std::vector<CycleInput>& stream, bool before) {
+// A fresh odometry stepped through the stream up to its first detection cycle: the cycle and
+// the state after it (with `before`: the state before it).
+struct Detection {
+  std::size_t cycle = 0;
+  std::unique_ptr<Odometry> state;  // null: no detection (the benchmark is skipped)
+};
+
+Detection RunToDetection(benchmark::State& state, const std::vector<CycleInput>& stream, bool before) {
+  auto od = Make();
   for (std::size_t k = 0; k < stream.size(); ++k) {
-    const Odometry previous(od);
-    if (od.Step(stream[k]).detected) {
+    const Odometry previous(*od);
+    if (od->Step(stream[k]).detected) {
       if (before) {
-        od = previous;
+        *od = previous;
       }
-      return k;
+      return {k, std::move(od)};
     }
   }
-  return 0;
+  state.SkipWithError("no detection");
+  return {};
 }
 
 // One Step timed by hand (the benchmarks below use manual time); its output.
@@ -134,18 +141,17 @@ BENCHMARK(BM_OdometryStepTg);
 // older candidate times out, replayed from a copy of the state after the detection.
 void BM_OdometryStepCompensatingTwoCandidates(benchmark::State& state) {
   const auto stream = MakeStream(400, 200, false);
-  auto od = Make();
-  const std::size_t d = StepToDetection(*od, stream, false);
-  if (d == 0) {
-    state.SkipWithError("no detection");
+  const Detection at = RunToDetection(state, stream, false);
+  if (!at.state) {
     return;
   }
-  auto snapshot = std::make_unique<Odometry>(*od);
+  const std::size_t d = at.cycle;
+  auto od = std::make_unique<Odometry>(*at.state);
   std::size_t i = d + 1;
   for (auto _ : state) {
     const auto& st = od->machine().state();
     if (i == stream.size() || !(st.candidates[0].active && st.candidates[1].active)) {
-      *od = *snapshot;
+      *od = *at.state;
       i = d + 1;
     }
     TimedStep(state, *od, stream[i]);
@@ -158,17 +164,15 @@ BENCHMARK(BM_OdometryStepCompensatingTwoCandidates)->UseManualTime();
 // The detection cycle with the deepest catch-up (start point d - 75, second d - 100).
 void BM_OdometryStepDetectionWorstCase(benchmark::State& state) {
   const auto stream = MakeStream(300, 200, true);
-  auto od = Make();
-  const std::size_t d = StepToDetection(*od, stream, true);
-  if (d == 0) {
-    state.SkipWithError("no detection");
+  const Detection at = RunToDetection(state, stream, true);
+  if (!at.state) {
     return;
   }
-  auto snapshot = std::make_unique<Odometry>(*od);
+  auto od = std::make_unique<Odometry>(*at.state);
   std::int32_t age = 0;
   for (auto _ : state) {
-    *od = *snapshot;
-    age = TimedStep(state, *od, stream[d]).start_age_cycles;
+    *od = *at.state;
+    age = TimedStep(state, *od, stream[at.cycle]).start_age_cycles;
   }
   if (age != 75) state.SkipWithError("not the deepest catch-up");
   state.SetLabel("catch-up 75 + 100 cycles");
