@@ -450,15 +450,23 @@ void ForEachStep(const rcli::JsonVector& v, const std::vector<std::string>& prob
   }
 }
 
+// A unit's setup call that returned `error`: a problem "<what>: <error>" unless kNone; true if so.
+template <typename Error>
+bool SetupFailed(Error error, const char* what, std::vector<std::string>& problems) {
+  if (error == Error::kNone) {
+    return false;
+  }
+  problems.push_back(std::string(what) + ": " + ToString(error));
+  return true;
+}
+
 void ReplayOnboard(const rcli::JsonVector& v, const FileConfig& cfg, std::vector<std::string>& problems) {
   auto created = ob::CrossingProtection::Create(cfg.protection);
-  if (created.error != ob::ProtectionError::kNone) {
-    problems.push_back(std::string("CrossingProtection::Create: ") + ToString(created.error));
+  if (SetupFailed(created.error, "CrossingProtection::Create", problems)) {
     return;
   }
   ob::CrossingProtection& prot = *created.protection;
-  if (const ob::ProtectionError e = prot.LoadCrossings(cfg.crossings); e != ob::ProtectionError::kNone) {
-    problems.push_back(std::string("LoadCrossings: ") + ToString(e));
+  if (SetupFailed(prot.LoadCrossings(cfg.crossings), "LoadCrossings", problems)) {
     return;
   }
   std::vector<ws::CrossingController> ctls = Controllers(cfg);
@@ -508,14 +516,12 @@ void ReplayOnboard(const rcli::JsonVector& v, const FileConfig& cfg, std::vector
 
 void ReplayGnss(const rcli::JsonVector& v, const FileConfig& cfg, std::vector<std::string>& problems) {
   auto created = ws::CentreScheduler::Create(cfg.scheduler);
-  if (created.error != ws::SchedulerError::kNone) {
-    problems.push_back(std::string("CentreScheduler::Create: ") + ToString(created.error));
+  if (SetupFailed(created.error, "CentreScheduler::Create", problems)) {
     return;
   }
   ws::CentreScheduler& centre = *created.scheduler;
-  if (const ws::SchedulerError e = centre.StartDeparture(cfg.departure, cfg.crossings, cfg.restrictions, cfg.started_at_ms);
-      e != ws::SchedulerError::kNone) {
-    problems.push_back(std::string("StartDeparture: ") + ToString(e));
+  if (SetupFailed(centre.StartDeparture(cfg.departure, cfg.crossings, cfg.restrictions, cfg.started_at_ms),
+                  "StartDeparture", problems)) {
     return;
   }
   std::vector<ws::CrossingController> ctls = Controllers(cfg);
