@@ -12,13 +12,7 @@ namespace railproof::lc::wayside {
 
 namespace {
 
-// @implements REQ-LC-008 REQ-LC-013
-bool ClockOk(std::int64_t t) noexcept { return t >= -lc::kMaxClockMs && t <= lc::kMaxClockMs; }
-
-// @implements REQ-LC-010 REQ-LC-012
-bool PositionOk(std::int64_t x) noexcept {
-  return x >= -core::kMaxPositionMm && x <= core::kMaxPositionMm;
-}
+// The range checks of times and positions are lc::ClockOk and lc::PositionOk (common part).
 
 // @implements REQ-LC-008 REQ-LC-010
 // st = t + eta - warning_time - allowance (design §5 steps 1 and 4), eta finite.
