@@ -47,22 +47,12 @@ CentreScheduler::CreateResult CentreScheduler::Create(const SchedulerConfig& con
 
 // @implements REQ-LC-008
 const ScheduledCrossing* CentreScheduler::Find(std::uint32_t crossing_id) const noexcept {
-  for (std::size_t i = 0; i < count_; ++i) {
-    if (crossings_[i].data.id == crossing_id) {
-      return &crossings_[i];
-    }
-  }
-  return nullptr;
+  return FindCrossing(std::span<const ScheduledCrossing>(crossings_.data(), count_), crossing_id);
 }
 
 // @implements REQ-LC-008
 ScheduledCrossing* CentreScheduler::FindMutable(std::uint32_t crossing_id) noexcept {
-  for (std::size_t i = 0; i < count_; ++i) {
-    if (crossings_[i].data.id == crossing_id) {
-      return &crossings_[i];
-    }
-  }
-  return nullptr;
+  return FindCrossing(std::span<ScheduledCrossing>(crossings_.data(), count_), crossing_id);
 }
 
 // Design §5 step 1 (REQ-LC-008).
