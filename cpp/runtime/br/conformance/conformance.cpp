@@ -15,51 +15,23 @@
 // vector, the step, the field, expected and actual.
 // Last line: "railproof-conformance-br: all N vectors passed" or
 // "railproof-conformance-br: vectors mismatched: K of N" or "...: error: <reason>".
-#include <gtest/gtest.h>
-
-#include <algorithm>
-#include <atomic>
+#include <cstddef>
 #include <cstdint>
-#include <cstdio>
-#include <filesystem>
-#include <fstream>
 #include <nlohmann/json.hpp>
-#include <set>
 #include <string>
-#include <utility>
 #include <vector>
 
 #include "railproof/br/supervisor.hpp"
-#include "railproof/testing/jsonl_vectors.hpp"
-#include "railproof/testing/runner_cli.hpp"
+#include "railproof/testing/jsonl_runner.hpp"
 
 namespace rcli = railproof::conformance;
 
 namespace {
 
-namespace fs = std::filesystem;
 namespace rb = railproof::br;
 using json = nlohmann::json;
 
-constexpr const char* kModel = "models/br.pml";
-constexpr const char* kUnits = "abstract speed units = mm/s";
-
-struct Vector {
-  std::string id;
-  std::string test_name;
-  std::string file;
-  std::size_t line = 0;
-  json steps;
-};
-
-std::vector<Vector> g_vectors;
-std::set<std::string> g_files;
-std::atomic<std::size_t> g_mismatched{0};
-std::atomic<std::size_t> g_replayed{0};
-
-// Checks the shape of one step (the schema is checked when the vectors are written; this
-// guards the harness against a hand-edited or truncated file).
-bool StepWellFormed(const json& step) {
+bool StepWellFormed(const std::string& /*file*/, const json& step) {
   if (!step.is_object() || !step.contains("in") || !step.contains("out")) {
     return false;
   }
@@ -80,96 +52,47 @@ bool StepWellFormed(const json& step) {
          out["emergency_latched"].is_boolean();
 }
 
-// Loads every br*.jsonl of dir; an error names the file and line.
-bool Load(const fs::path& dir, std::string& error) {
-  std::size_t files = 0;
-  error = rcli::ReadVectorDirectory(
-      dir, "br",
-      [](const std::string& file, const json& obj) -> std::string {
-        if (obj.value("kind", "") != "header" || obj.value("model", "") != kModel || !obj.contains("parameters")) {
-          return "first line is not a " + std::string(kModel) + " vector header";
-        }
-        if (obj.value("units", "") != kUnits) {
-          return "header units must be \"" + std::string(kUnits) + "\"";
-        }
-        g_files.insert(file);
-        return "";
-      },
-      [](const rcli::VectorLine& line) -> std::string {
-        for (const json& step : (*line.obj)["steps"]) {
-          if (!StepWellFormed(step)) {
-            return "malformed step in vector " + line.id;
-          }
-        }
-        g_vectors.push_back(Vector{line.id, line.test_name, line.file, line.line, (*line.obj)["steps"]});
-        return "";
-      },
-      files);
-  return error.empty();
+void Replay(const rcli::JsonVector& v, std::vector<std::string>& problems) {
+  rb::Supervisor sup;
+  for (std::size_t k = 0; k < v.steps.size() && problems.empty(); ++k) {
+    const json& in = v.steps[k].at("in");
+    const json& out = v.steps[k].at("out");
+    rb::PatternSpeeds p;
+    p.v_s = in.at("v_s").get<std::int64_t>();
+    p.v_e = in.at("v_e").get<std::int64_t>();
+    p.v_7n = in.at("v_7n").get<std::int64_t>();
+    p.v_6n = in.at("v_6n").get<std::int64_t>();
+    p.v_5n = in.at("v_5n").get<std::int64_t>();
+    p.v_4n = in.at("v_4n").get<std::int64_t>();
+    p.v_release = in.at("v_release").get<std::int64_t>();
+    rb::DriverInputs d;
+    d.standstill = in.at("standstill").get<bool>();
+    d.handle_emergency = in.at("handle_emergency").get<bool>();
+    d.reset = in.at("reset").get<bool>();
+    const rb::Decision got = sup.Step(p, d);
+    rcli::Checker chk(problems, "step " + std::to_string(k) + " (cycle " + std::to_string(k + 1) + "): ", &in);
+    chk.Expect("level", out.at("level").get<std::string>(), rb::ToString(got.level));
+    chk.Expect("pattern_approaching", rcli::Bool(out.at("pattern_approaching").get<bool>()),
+               rcli::Bool(got.pattern_approaching));
+    chk.Expect("emergency_latched", rcli::Bool(out.at("emergency_latched").get<bool>()),
+               rcli::Bool(got.emergency_latched));
+    chk.Expect("Supervisor::emergency_latched()", rcli::Bool(out.at("emergency_latched").get<bool>()),
+               rcli::Bool(sup.emergency_latched()));
+  }
 }
-
-const char* Bool(bool b) { return b ? "true" : "false"; }
-
-class VectorTest : public testing::Test {
- public:
-  explicit VectorTest(std::size_t index) : index_(index) {}
-  void TestBody() override {
-    const Vector& v = g_vectors[index_];
-    g_replayed.fetch_add(1);
-    RecordProperty("vector_id", v.id);
-    std::vector<std::string> problems;
-    Replay(v, problems);
-    if (!problems.empty()) {
-      g_mismatched.fetch_add(1);
-    }
-    for (const std::string& p : problems) {
-      ADD_FAILURE_AT(v.file.c_str(), static_cast<int>(v.line)) << "vector " << v.id << ": " << p;
-    }
-  }
-
- private:
-  static void Replay(const Vector& v, std::vector<std::string>& problems) {
-    rb::Supervisor sup;
-    for (std::size_t k = 0; k < v.steps.size() && problems.empty(); ++k) {
-      const json& in = v.steps[k].at("in");
-      const json& out = v.steps[k].at("out");
-      rb::PatternSpeeds p;
-      p.v_s = in.at("v_s").get<std::int64_t>();
-      p.v_e = in.at("v_e").get<std::int64_t>();
-      p.v_7n = in.at("v_7n").get<std::int64_t>();
-      p.v_6n = in.at("v_6n").get<std::int64_t>();
-      p.v_5n = in.at("v_5n").get<std::int64_t>();
-      p.v_4n = in.at("v_4n").get<std::int64_t>();
-      p.v_release = in.at("v_release").get<std::int64_t>();
-      rb::DriverInputs d;
-      d.standstill = in.at("standstill").get<bool>();
-      d.handle_emergency = in.at("handle_emergency").get<bool>();
-      d.reset = in.at("reset").get<bool>();
-      const rb::Decision got = sup.Step(p, d);
-      auto expect = [&](const std::string& field, const std::string& expected, const std::string& actual) {
-        if (expected != actual) {
-          problems.push_back("step " + std::to_string(k) + " (cycle " + std::to_string(k + 1) + "): " + field +
-                             " expected " + expected + ", got " + actual + " [inputs " + in.dump() + "]");
-        }
-      };
-      expect("level", out.at("level").get<std::string>(), rb::ToString(got.level));
-      expect("pattern_approaching", Bool(out.at("pattern_approaching").get<bool>()), Bool(got.pattern_approaching));
-      expect("emergency_latched", Bool(out.at("emergency_latched").get<bool>()), Bool(got.emergency_latched));
-      expect("Supervisor::emergency_latched()", Bool(out.at("emergency_latched").get<bool>()),
-             Bool(sup.emergency_latched()));
-    }
-  }
-
-  std::size_t index_;
-};
-
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  return rcli::RunnerMain<VectorTest>(
-      "railproof-conformance-br", "BrakingConformance",
-      "Replays every br*.jsonl vector of DIR against the C++ speed-supervision decision\n"
-      "(br::Supervisor). Exit 0 only if every vector matches.",
-      argc, argv, Load, g_vectors, g_files, g_mismatched, g_replayed);
+  return rcli::RunJsonVectors({.prog = "railproof-conformance-br",
+                               .suite = "BrakingConformance",
+                               .description = "Replays every br*.jsonl vector of DIR against the C++ speed-supervision "
+                                              "decision\n(br::Supervisor). Exit 0 only if every vector matches.",
+                               .prefix = "br",
+                               .models = {"models/br.pml"},
+                               .units = "abstract speed units = mm/s",
+                               .header = nullptr,  // nothing else in the header
+                               .step_ok = StepWellFormed,
+                               .replay = Replay},
+                              argc, argv);
 }

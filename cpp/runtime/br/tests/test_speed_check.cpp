@@ -71,6 +71,14 @@ TwoCounterSpeedCheck OpenAt30(std::int64_t& t) {
   return c;
 }
 
+// OpenAt30, then one gate slower than the check speed (11 ticks, 5 pulses): a release
+// decided at t = 11; the closing pulse opened the next gate.
+TwoCounterSpeedCheck ReleasedAt30(std::int64_t& t) {
+  auto c = OpenAt30(t);
+  EXPECT_TRUE(Gate(c, t, 11, 5).closed);
+  return c;
+}
+
 // ---- configuration (typed validation) -----------------------------------------------------
 
 // @verifies REQ-SC-002 REQ-SC-003
@@ -204,9 +212,7 @@ TEST(SpeedCheckGate, EarlyReleaseOnlyAtATgPulseAfterCounter1PassedN1f) {
 // @verifies REQ-SC-003
 TEST(SpeedCheckFailSafe, SilentTgBrakesAfterTheGateTimeout) {
   std::int64_t t = 0;
-  auto c = OpenAt30(t);
-  const GateResult g = Gate(c, t, 11, 5);  // release decided at t = 11
-  ASSERT_TRUE(g.closed);
+  auto c = ReleasedAt30(t);
   ASSERT_FALSE(c.Output().brake);
   // the TG falls silent; the oscillator keeps running
   const std::int64_t timeout = params::sc::gate_timeout_ms;
@@ -239,8 +245,7 @@ TEST(SpeedCheckFailSafe, StandstillBrakes) {
 // @verifies REQ-SC-003
 TEST(SpeedCheckFailSafe, StoppedOscillatorBrakes) {
   std::int64_t t = 0;
-  auto c = OpenAt30(t);
-  (void)Gate(c, t, 11, 5);
+  auto c = ReleasedAt30(t);
   ASSERT_FALSE(c.Output().brake);
   c.OnTime(t + 5);  // last tick at t; timeout 5 ms
   EXPECT_FALSE(c.Output().brake);
@@ -267,8 +272,7 @@ TEST(SpeedCheckFailSafe, StoppedOscillatorBrakes) {
 // @verifies REQ-SC-002
 TEST(SpeedCheckFailSafe, UnknownCheckSpeedBrakes) {
   std::int64_t t = 0;
-  auto c = OpenAt30(t);
-  (void)Gate(c, t, 11, 5);
+  auto c = ReleasedAt30(t);
   ASSERT_FALSE(c.Output().brake);
   EXPECT_EQ(c.SelectCheckSpeed(45, t), SelectVerdict::kUnknownCheckSpeed);
   EXPECT_TRUE(c.Output().brake);
@@ -286,8 +290,7 @@ TEST(SpeedCheckFailSafe, UnknownCheckSpeedBrakes) {
 // @verifies REQ-SC-003
 TEST(SpeedCheckFailSafe, ClockGoingBackwardsLatchesUntilReset) {
   std::int64_t t = 0;
-  auto c = OpenAt30(t);
-  (void)Gate(c, t, 11, 5);
+  auto c = ReleasedAt30(t);
   c.OnTime(t - 1);
   EXPECT_EQ(c.Output().reason, SpeedCheckReason::kClockFault);
   std::int64_t u = t + 1;
@@ -304,8 +307,7 @@ TEST(SpeedCheckFailSafe, ClockGoingBackwardsLatchesUntilReset) {
 // @verifies REQ-SC-002
 TEST(SpeedCheckSelect, CheckSpeedChangeSelectsN2eAndRestartsTheGate) {
   std::int64_t t = 0;
-  auto c = OpenAt30(t);
-  (void)Gate(c, t, 11, 5);
+  auto c = ReleasedAt30(t);
   ASSERT_FALSE(c.Output().brake);
   EXPECT_EQ(c.SelectCheckSpeed(30, t), SelectVerdict::kUnchanged);
   EXPECT_TRUE(c.GateOpen());

@@ -19,15 +19,7 @@ namespace railproof::br {
 namespace {
 
 PatternSpeeds At(std::int64_t v_s) {
-  PatternSpeeds p;
-  p.v_s = v_s;
-  p.v_e = 100;
-  p.v_7n = 90;
-  p.v_6n = 80;
-  p.v_5n = 70;
-  p.v_4n = 60;
-  p.v_release = 50;
-  return p;
+  return PatternSpeeds{.v_s = v_s, .v_e = 100, .v_7n = 90, .v_6n = 80, .v_5n = 70, .v_4n = 60, .v_release = 50};
 }
 
 constexpr DriverInputs kNoInputs{false, false, false};

@@ -30,46 +30,31 @@
 // CLOSED report that lists it (design §3 item 3).
 // Last line: "railproof-conformance-lc: all N vectors passed" or
 // "railproof-conformance-lc: vectors mismatched: K of N" or "...: error: <reason>".
-#include <gtest/gtest.h>
-
-#include <algorithm>
 #include <array>
-#include <atomic>
 #include <cstddef>
 #include <cstdint>
-#include <cstdio>
-#include <filesystem>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <optional>
-#include <set>
 #include <span>
 #include <string>
 #include <vector>
 
-#include "railproof/testing/jsonl_vectors.hpp"
 #include "railproof/br/patterns.hpp"
 #include "railproof/lc/onboard/crossing_protection.hpp"
 #include "railproof/lc/wayside/centre_scheduler.hpp"
 #include "railproof/lc/wayside/crossing_controller.hpp"
-#include "railproof/testing/runner_cli.hpp"
+#include "railproof/testing/jsonl_runner.hpp"
 
 namespace rcli = railproof::conformance;
 
 namespace {
 
-namespace fs = std::filesystem;
 namespace ob = railproof::lc::onboard;
 namespace ws = railproof::lc::wayside;
 namespace br = railproof::br;
 using json = nlohmann::json;
 
-// the two level-crossing models: the on-board-requested warning and the GNSS-time crossings
-constexpr std::array<const char*, 2> kModels{"models/lc.pml", "models/lc_gnss.pml"};
-
-bool IsLcModel(const std::string& model) {
-  return std::any_of(kModels.begin(), kModels.end(), [&](const char* m) { return model == m; });
-}
 constexpr const char* kUnits = "model tick = 10000 ms, model cell = 100000 mm (positions in half-cells)";
 constexpr std::int64_t kTickMs = 10000;
 
@@ -85,20 +70,7 @@ struct FileConfig {
   std::int64_t started_at_ms = 0;
 };
 
-struct Vector {
-  std::string id;
-  std::string test_name;
-  std::string file;
-  std::size_t line = 0;
-  const FileConfig* config = nullptr;
-  json steps;
-};
-
-std::vector<Vector> g_vectors;
-std::set<std::string> g_files;
 std::map<std::string, FileConfig> g_configs;  // per file, from its header
-std::atomic<std::size_t> g_mismatched{0};
-std::atomic<std::size_t> g_replayed{0};
 
 bool IsInt(const json& o, const char* k) { return o.is_object() && o.contains(k) && o[k].is_number_integer(); }
 bool IsBool(const json& o, const char* k) { return o.is_object() && o.contains(k) && o[k].is_boolean(); }
@@ -182,8 +154,7 @@ std::string ConfigFromHeader(const json& h, FileConfig& cfg) {
   return "";
 }
 
-// ---- step shape (the schema is checked when the vectors are written; this guards the harness
-// against a hand-edited or truncated file) ----------------------------------------------------
+// ---- step shape ------------------------------------------------------------------------------
 bool IdsOk(const json& o, const char* k) {
   if (!IsArr(o, k)) {
     return false;
@@ -237,7 +208,8 @@ bool ControllerStepOk(const json& c, bool gnss) {
          out["clock"].is_string();
 }
 
-bool StepWellFormed(const json& step, bool gnss) {
+bool StepWellFormed(const std::string& file, const json& step) {
+  const bool gnss = g_configs.at(file).gnss;
   if (!step.is_object() || !IsInt(step, "t_ms") || !IsArr(step, "controllers") || step["controllers"].size() != 2 ||
       !IsObj(step, "train")) {
     return false;
@@ -296,50 +268,21 @@ bool StepWellFormed(const json& step, bool gnss) {
                            IsInt(pos, "rear_mm") && IsInt(pos, "speed_mm_s"));
 }
 
-// Loads every lc*.jsonl of dir; an error names the file and line.
-bool Load(const fs::path& dir, std::string& error) {
-  std::size_t files = 0;
-  error = rcli::ReadVectorDirectory(
-      dir, "lc",
-      [](const std::string& file, const json& obj) -> std::string {
-        if (obj.value("kind", "") != "header" || !IsLcModel(obj.value("model", "")) || !obj.contains("parameters")) {
-          return "first line is not a models/lc.pml or models/lc_gnss.pml vector header";
-        }
-        if (obj.value("units", "") != kUnits) {
-          return "header units must be \"" + std::string(kUnits) + "\"";
-        }
-        FileConfig cfg;
-        if (std::string e = ConfigFromHeader(obj, cfg); !e.empty()) {
-          return e;
-        }
-        g_configs[file] = cfg;
-        g_files.insert(file);
-        return "";
-      },
-      [](const rcli::VectorLine& line) -> std::string {
-        const FileConfig& cfg = g_configs.at(line.file);
-        for (const json& step : (*line.obj)["steps"]) {
-          if (!StepWellFormed(step, cfg.gnss)) {
-            return "malformed step in vector " + line.id;
-          }
-        }
-        g_vectors.push_back(Vector{line.id, line.test_name, line.file, line.line, nullptr, (*line.obj)["steps"]});
-        return "";
-      },
-      files);
-  if (error.empty()) {
-    for (Vector& v : g_vectors) {
-      v.config = &g_configs.at(v.file);  // the map is complete: its addresses are stable now
-    }
+// A file's header: the configuration of its vectors.
+std::string Header(const std::string& file, const json& obj) {
+  FileConfig cfg;
+  if (std::string e = ConfigFromHeader(obj, cfg); !e.empty()) {
+    return e;
   }
-  return error.empty();
+  g_configs[file] = cfg;
+  return "";
 }
 
 // ---- comparison helpers -------------------------------------------------------------------
 std::string Str(std::int64_t x) { return std::to_string(x); }
-std::string Bool(bool b) { return b ? "true" : "false"; }
-std::string OptInt(const json& j) { return j.is_null() ? "null" : Str(j.get<std::int64_t>()); }
-std::string OptInt(const std::optional<std::int64_t>& x) { return x.has_value() ? Str(*x) : "null"; }
+using rcli::Bool;
+using rcli::Checker;
+using rcli::OptInt;
 std::string Ids(const json& a) {
   std::string s = "[";
   for (std::size_t i = 0; i < a.size(); ++i) {
@@ -355,21 +298,6 @@ std::string Ids(std::span<const T> a) {
   }
   return s + "]";
 }
-
-class Checker {
- public:
-  Checker(std::vector<std::string>& problems, std::string where) : problems_(problems), where_(std::move(where)) {}
-  void Expect(const std::string& field, const std::string& expected, const std::string& actual) {
-    if (expected != actual) {
-      problems_.push_back(where_ + field + " expected " + expected + ", got " + actual);
-    }
-  }
-  void Fail(const std::string& what) { problems_.push_back(where_ + what); }
-
- private:
-  std::vector<std::string>& problems_;
-  std::string where_;
-};
 
 ob::CrossingStatus StatusOf(const std::string& s) {
   if (s == "WARNING") {
@@ -502,26 +430,47 @@ std::string EtaClass(std::int64_t eta_ms) {
   return Str(2 * (eta_ms / kTickMs) + (eta_ms % kTickMs != 0 ? 1 : 0));
 }
 
-void ReplayOnboard(const Vector& v, std::vector<std::string>& problems) {
-  const FileConfig& cfg = *v.config;
-  auto created = ob::CrossingProtection::Create(cfg.protection);
-  if (created.error != ob::ProtectionError::kNone) {
-    problems.push_back(std::string("CrossingProtection::Create: ") + ToString(created.error));
-    return;
-  }
-  ob::CrossingProtection& prot = *created.protection;
-  if (const ob::ProtectionError e = prot.LoadCrossings(cfg.crossings); e != ob::ProtectionError::kNone) {
-    problems.push_back(std::string("LoadCrossings: ") + ToString(e));
-    return;
-  }
+// Fresh controllers of a file's crossings (their configurations were accepted with the header).
+std::vector<ws::CrossingController> Controllers(const FileConfig& cfg) {
   std::vector<ws::CrossingController> ctls;
   for (const ws::ControllerConfig& cc : cfg.controllers) {
     ctls.push_back(*ws::CrossingController::Create(cc).controller);
   }
+  return ctls;
+}
+
+// Calls replay(step, t_ms, "step k (t=... ms): ") for every step of v in order, until the
+// first problem.
+template <typename StepFn>
+void ForEachStep(const rcli::JsonVector& v, const std::vector<std::string>& problems, StepFn&& replay) {
   for (std::size_t k = 0; k < v.steps.size() && problems.empty(); ++k) {
     const json& step = v.steps[k];
     const std::int64_t now = I(step, "t_ms");
-    const std::string at = "step " + std::to_string(k) + " (t=" + Str(now) + " ms): ";
+    replay(step, now, "step " + std::to_string(k) + " (t=" + Str(now) + " ms): ");
+  }
+}
+
+// A unit's setup call that returned `error`: a problem "<what>: <error>" unless kNone; true if so.
+template <typename Error>
+bool SetupFailed(Error error, const char* what, std::vector<std::string>& problems) {
+  if (error == Error::kNone) {
+    return false;
+  }
+  problems.push_back(std::string(what) + ": " + ToString(error));
+  return true;
+}
+
+void ReplayOnboard(const rcli::JsonVector& v, const FileConfig& cfg, std::vector<std::string>& problems) {
+  auto created = ob::CrossingProtection::Create(cfg.protection);
+  if (SetupFailed(created.error, "CrossingProtection::Create", problems)) {
+    return;
+  }
+  ob::CrossingProtection& prot = *created.protection;
+  if (SetupFailed(prot.LoadCrossings(cfg.crossings), "LoadCrossings", problems)) {
+    return;
+  }
+  std::vector<ws::CrossingController> ctls = Controllers(cfg);
+  ForEachStep(v, problems, [&](const json& step, std::int64_t now, const std::string& at) {
     for (std::size_t c = 0; c < ctls.size(); ++c) {
       Checker chk(problems, at + "controller " + Str(cfg.crossings[c].id) + " ");
       StepController(ctls[c], now, step.at("controllers")[c], false, chk);
@@ -550,7 +499,7 @@ void ReplayOnboard(const Vector& v, std::vector<std::string>& problems) {
     Checker chk(problems, at + "on-board ");
     if (const ob::ProtectionError e = prot.Cycle(pi); e != ob::ProtectionError::kNone) {
       chk.Fail(std::string("Cycle rejected the inputs: ") + ToString(e) + " [inputs " + tr.dump() + "]");
-      break;
+      return;
     }
     const auto entries = prot.Entries();
     for (std::size_t c = 0; c < entries.size() && c < out.at("states").size(); ++c) {
@@ -562,30 +511,21 @@ void ReplayOnboard(const Vector& v, std::vector<std::string>& problems) {
     chk.Expect("requests", Ids(out.at("requests")), Ids(o.Requests()));
     chk.Expect("withdrawals", Ids(out.at("withdrawals")), Ids(o.Withdrawals()));
     chk.Expect("stop_limit_mm", OptInt(out.at("stop_limit_mm")), OptInt(o.stop_limit_mm));
-  }
+  });
 }
 
-void ReplayGnss(const Vector& v, std::vector<std::string>& problems) {
-  const FileConfig& cfg = *v.config;
+void ReplayGnss(const rcli::JsonVector& v, const FileConfig& cfg, std::vector<std::string>& problems) {
   auto created = ws::CentreScheduler::Create(cfg.scheduler);
-  if (created.error != ws::SchedulerError::kNone) {
-    problems.push_back(std::string("CentreScheduler::Create: ") + ToString(created.error));
+  if (SetupFailed(created.error, "CentreScheduler::Create", problems)) {
     return;
   }
   ws::CentreScheduler& centre = *created.scheduler;
-  if (const ws::SchedulerError e = centre.StartDeparture(cfg.departure, cfg.crossings, cfg.restrictions, cfg.started_at_ms);
-      e != ws::SchedulerError::kNone) {
-    problems.push_back(std::string("StartDeparture: ") + ToString(e));
+  if (SetupFailed(centre.StartDeparture(cfg.departure, cfg.crossings, cfg.restrictions, cfg.started_at_ms),
+                  "StartDeparture", problems)) {
     return;
   }
-  std::vector<ws::CrossingController> ctls;
-  for (const ws::ControllerConfig& cc : cfg.controllers) {
-    ctls.push_back(*ws::CrossingController::Create(cc).controller);
-  }
-  for (std::size_t k = 0; k < v.steps.size() && problems.empty(); ++k) {
-    const json& step = v.steps[k];
-    const std::int64_t now = I(step, "t_ms");
-    const std::string at = "step " + std::to_string(k) + " (t=" + Str(now) + " ms): ";
+  std::vector<ws::CrossingController> ctls = Controllers(cfg);
+  ForEachStep(v, problems, [&](const json& step, std::int64_t now, const std::string& at) {
     const json& in = step.at("centre").at("in");
     const json& out = step.at("centre").at("out");
     std::vector<ws::StartTimeAck> sacks;
@@ -617,7 +557,7 @@ void ReplayGnss(const Vector& v, std::vector<std::string>& problems) {
       Checker chk(problems, at + "centre ");
       if (const ws::SchedulerError e = centre.Cycle(si); e != ws::SchedulerError::kNone) {
         chk.Fail(std::string("Cycle rejected the inputs: ") + ToString(e) + " [inputs " + in.dump() + "]");
-        break;
+        return;
       }
       const ws::SchedulerOutput& o = centre.Output();
       chk.Expect("departure_cleared", Bool(out.at("departure_cleared").get<bool>()), Bool(o.departure_cleared));
@@ -660,41 +600,34 @@ void ReplayGnss(const Vector& v, std::vector<std::string>& problems) {
       Checker chk(problems, at + "controller " + Str(cfg.crossings[c].id) + " ");
       StepController(ctls[c], now, step.at("controllers")[c], true, chk);
     }
-  }
+  });
 }
 
-class VectorTest : public testing::Test {
- public:
-  explicit VectorTest(std::size_t index) : index_(index) {}
-  void TestBody() override {
-    const Vector& v = g_vectors[index_];
-    g_replayed.fetch_add(1);
-    RecordProperty("vector_id", v.id);
-    std::vector<std::string> problems;
-    if (v.config->gnss) {
-      ReplayGnss(v, problems);
-    } else {
-      ReplayOnboard(v, problems);
-    }
-    if (!problems.empty()) {
-      g_mismatched.fetch_add(1);
-    }
-    for (const std::string& p : problems) {
-      ADD_FAILURE_AT(v.file.c_str(), static_cast<int>(v.line)) << "vector " << v.id << ": " << p;
-    }
+void Replay(const rcli::JsonVector& v, std::vector<std::string>& problems) {
+  const FileConfig& cfg = g_configs.at(v.file);
+  if (cfg.gnss) {
+    ReplayGnss(v, cfg, problems);
+  } else {
+    ReplayOnboard(v, cfg, problems);
   }
-
- private:
-  std::size_t index_;
-};
+}
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  return rcli::RunnerMain<VectorTest>(
-      "railproof-conformance-lc", "LevelCrossingConformance",
-      "Replays every lc*.jsonl vector of DIR against the C++ level-crossing units\n"
-      "(lc::onboard::CrossingProtection, lc::wayside::CrossingController, lc::wayside::CentreScheduler),\n"
-      "configured by each file's header. Exit 0 only if every vector matches.",
-      argc, argv, Load, g_vectors, g_files, g_mismatched, g_replayed);
+  return rcli::RunJsonVectors(
+      {.prog = "railproof-conformance-lc",
+       .suite = "LevelCrossingConformance",
+       .description = "Replays every lc*.jsonl vector of DIR against the C++ level-crossing units\n"
+                      "(lc::onboard::CrossingProtection, lc::wayside::CrossingController, "
+                      "lc::wayside::CentreScheduler),\nconfigured by each file's header. Exit 0 only if every "
+                      "vector matches.",
+       .prefix = "lc",
+       // the two level-crossing models: the on-board-requested warning and the GNSS-time crossings
+       .models = {"models/lc.pml", "models/lc_gnss.pml"},
+       .units = kUnits,
+       .header = Header,
+       .step_ok = StepWellFormed,
+       .replay = Replay},
+      argc, argv);
 }

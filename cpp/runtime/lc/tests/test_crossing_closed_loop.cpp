@@ -13,6 +13,7 @@
 #include <array>
 #include <cstdint>
 #include <optional>
+#include <span>
 #include <vector>
 
 #include "railproof/generated/lc_params.hpp"
@@ -87,6 +88,33 @@ struct LoopResult {
 
 bool OnCrossing(const Train& t) { return t.FrontMax() >= kLc.near_mm && t.RearMin() < kLc.far_mm; }
 
+// The check of every cycle: the train's envelope on the crossing (after the train's step at
+// now + kDt) only while it is CLOSED and has warned for its design warning time.
+void CheckEnvelope(const Train& train, std::int64_t now, const CrossingController& c, LoopResult& r) {
+  if (OnCrossing(train)) {
+    const std::int64_t warned = now + kDt - c.Status().warning_start_ms;
+    const bool ok = c.State() == ControllerState::kClosed && warned >= kLc.warning_time_ms;
+    r.violations += ok ? 0 : 1;
+    if (r.min_warning_at_entry < 0) {
+      r.min_warning_at_entry = warned;
+    }
+  }
+}
+
+// The controller's cycle at `now` with the barrier's detection, then the barrier's movement.
+void CycleWithBarrier(CrossingController& c, std::int64_t now, ControllerInput ci, Barrier& barrier) {
+  ci.now_ms = now;
+  ci.barrier_down = barrier.Down();
+  ci.barrier_up = barrier.Up();
+  EXPECT_EQ(c.Cycle(ci), lc::wayside::ControllerError::kNone);
+  barrier.Step(c.Output().barriers_down_commanded);
+}
+
+// The report in flight as the receiver's input (none or one).
+std::span<const CrossingReport> Delivered(const std::optional<CrossingReport>& report) {
+  return report.has_value() ? std::span<const CrossingReport>(&*report, 1) : std::span<const CrossingReport>();
+}
+
 // On-board-requested crossing, messages delayed by one cycle.
 LoopResult OnboardLoop(bool barrier_stuck, std::int64_t start_front) {
   auto p_created = CrossingProtection::Create(DefaultProtectionConfig(kTrain, kLength, kAccel));
@@ -107,13 +135,9 @@ LoopResult OnboardLoop(bool barrier_stuck, std::int64_t start_front) {
   std::vector<WithdrawalAck> acks;
   for (std::int64_t now = 0; now <= 400'000; now += kDt) {
     ControllerInput ci;
-    ci.now_ms = now;
     ci.requests = requests;
     ci.withdrawals = withdrawals;
-    ci.barrier_down = barrier.Down();
-    ci.barrier_up = barrier.Up();
-    EXPECT_EQ(c.Cycle(ci), lc::wayside::ControllerError::kNone);
-    barrier.Step(c.Output().barriers_down_commanded);
+    CycleWithBarrier(c, now, ci, barrier);
 
     ProtectionInput pi;
     pi.now_ms = now;
@@ -122,11 +146,7 @@ LoopResult OnboardLoop(bool barrier_stuck, std::int64_t start_front) {
     pi.rear_error_mm = kErr;
     pi.speed_mm_s = train.v;
     pi.restrictions = kProfile;
-    std::array<CrossingReport, 1> reports{};
-    if (report.has_value()) {
-      reports[0] = *report;
-      pi.reports = reports;
-    }
+    pi.reports = Delivered(report);
     pi.acks = acks;
     EXPECT_EQ(p.Cycle(pi), ProtectionError::kNone);
 
@@ -148,14 +168,7 @@ LoopResult OnboardLoop(bool barrier_stuck, std::int64_t start_front) {
     }
 
     train.Step(p.Output().stop_limit_mm);
-    if (OnCrossing(train)) {
-      const std::int64_t warned = now + kDt - c.Status().warning_start_ms;
-      const bool ok = c.State() == ControllerState::kClosed && warned >= kLc.warning_time_ms;
-      r.violations += ok ? 0 : 1;
-      if (r.min_warning_at_entry < 0) {
-        r.min_warning_at_entry = warned;
-      }
-    }
+    CheckEnvelope(train, now, c, r);
     r.trace.push_back(train.front);
     r.trace.push_back(static_cast<std::int64_t>(p.Find(kLc.id)->state));
     r.trace.push_back(static_cast<std::int64_t>(c.State()));
@@ -230,24 +243,16 @@ LoopResult GnssLoop(std::int64_t late_ms, bool clock_fault) {
   std::optional<CrossingReport> report;
   for (std::int64_t now = 0; now <= 400'000; now += kDt) {
     ControllerInput ci;
-    ci.now_ms = now;
-    ci.barrier_down = barrier.Down();
-    ci.barrier_up = barrier.Up();
     ci.start_times = starts;
     ci.warning_stops = stops;
     ci.clock = clock_fault ? lc::wayside::ClockInput::kFault : lc::wayside::ClockInput::kGnss;
-    EXPECT_EQ(c.Cycle(ci), lc::wayside::ControllerError::kNone);
-    barrier.Step(c.Output().barriers_down_commanded);
+    CycleWithBarrier(c, now, ci, barrier);
 
     lc::wayside::SchedulerInput si;
     si.now_ms = now;
     si.start_acks = start_acks;
     si.stop_acks = stop_acks;
-    std::array<CrossingReport, 1> reports{};
-    if (report.has_value()) {
-      reports[0] = *report;
-      si.reports = reports;
-    }
+    si.reports = Delivered(report);
     si.restrictions = kProfile;
     if (now % params::lc::position_report_ms == 0) {
       si.position = messages::CentrePositionReport{kTrain, now, train.FrontMax(), train.RearMin(), train.v};
@@ -264,14 +269,7 @@ LoopResult GnssLoop(std::int64_t late_ms, bool clock_fault) {
       train.moving_allowed = true;
     }
     train.Step(std::nullopt);
-    if (OnCrossing(train)) {
-      const std::int64_t warned = now + kDt - c.Status().warning_start_ms;
-      const bool ok = c.State() == ControllerState::kClosed && warned >= kLc.warning_time_ms;
-      r.violations += ok ? 0 : 1;
-      if (r.min_warning_at_entry < 0) {
-        r.min_warning_at_entry = warned;
-      }
-    }
+    CheckEnvelope(train, now, c, r);
     r.trace.push_back(train.front);
     r.trace.push_back(static_cast<std::int64_t>(c.State()));
   }

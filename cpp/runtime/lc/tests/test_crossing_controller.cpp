@@ -12,6 +12,7 @@
 
 #include <array>
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "railproof/testing/enum_names.hpp"
@@ -61,12 +62,20 @@ ControllerInput Moving(std::int64_t now) {
   return in;
 }
 
+// `in` with requests from, or withdrawals by, `trains`.
+ControllerInput Requesting(ControllerInput in, std::span<const std::uint32_t> trains) {
+  in.requests = trains;
+  return in;
+}
+ControllerInput Withdrawing(ControllerInput in, std::span<const std::uint32_t> trains) {
+  in.withdrawals = trains;
+  return in;
+}
+
 // Requested by train A at 0 and closed at 9000 (ws = 0).
 CrossingController ClosedByA() {
   CrossingController c = Make();
-  ControllerInput in = At(0);
-  in.requests = kTrainA;
-  EXPECT_EQ(c.Cycle(in), ControllerError::kNone);
+  EXPECT_EQ(c.Cycle(Requesting(At(0), kTrainA)), ControllerError::kNone);
   EXPECT_EQ(c.Cycle(Moving(kLower)), ControllerError::kNone);
   EXPECT_EQ(c.Cycle(Down(9'000)), ControllerError::kNone);
   EXPECT_EQ(c.State(), ControllerState::kClosed);
@@ -83,9 +92,7 @@ TEST(LcCrossingController, FullSequenceWithTimers) {
   EXPECT_FALSE(c.Output().lights_on);
   EXPECT_FALSE(c.Output().barriers_down_commanded);
 
-  ControllerInput in = At(1'000);
-  in.requests = kTrainA;
-  ASSERT_EQ(c.Cycle(in), ControllerError::kNone);
+  ASSERT_EQ(c.Cycle(Requesting(At(1'000), kTrainA)), ControllerError::kNone);
   EXPECT_EQ(c.State(), ControllerState::kWarning);
   EXPECT_EQ(c.Status().warning_start_ms, 1'000);
   EXPECT_EQ(c.Output().report.status, CrossingStatus::kWarning);
@@ -110,9 +117,7 @@ TEST(LcCrossingController, FullSequenceWithTimers) {
   ASSERT_EQ(c.Cycle(Down(12'500)), ControllerError::kNone);
   EXPECT_EQ(c.Output().report.status, CrossingStatus::kClosed);  // every cycle
 
-  in = Down(13'000);
-  in.withdrawals = kTrainA;
-  ASSERT_EQ(c.Cycle(in), ControllerError::kNone);
+  ASSERT_EQ(c.Cycle(Withdrawing(Down(13'000), kTrainA)), ControllerError::kNone);
   EXPECT_EQ(c.State(), ControllerState::kOpening);
   ASSERT_EQ(c.Output().WithdrawalAcks().size(), 1U);
   EXPECT_EQ(c.Output().WithdrawalAcks()[0], 101U);
@@ -133,9 +138,7 @@ TEST(LcCrossingController, FullSequenceWithTimers) {
 TEST(LcCrossingController, BarrierNotDownFailsAndNeverReportsClosed) {
   {
     CrossingController c = Make();
-    ControllerInput in = At(0);
-    in.requests = kTrainA;
-    ASSERT_EQ(c.Cycle(in), ControllerError::kNone);
+    ASSERT_EQ(c.Cycle(Requesting(At(0), kTrainA)), ControllerError::kNone);
     ASSERT_EQ(c.Cycle(Moving(kLower)), ControllerError::kNone);
     ASSERT_EQ(c.Cycle(Moving(kLower + kTimeout - 1)), ControllerError::kNone);
     EXPECT_EQ(c.State(), ControllerState::kClosing);
@@ -143,9 +146,7 @@ TEST(LcCrossingController, BarrierNotDownFailsAndNeverReportsClosed) {
     EXPECT_EQ(c.State(), ControllerState::kClosed);
   }
   CrossingController c = Make();
-  ControllerInput in = At(0);
-  in.requests = kTrainA;
-  ASSERT_EQ(c.Cycle(in), ControllerError::kNone);
+  ASSERT_EQ(c.Cycle(Requesting(At(0), kTrainA)), ControllerError::kNone);
   ASSERT_EQ(c.Cycle(Moving(kLower)), ControllerError::kNone);
   ASSERT_EQ(c.Cycle(Moving(kLower + kTimeout)), ControllerError::kNone);
   EXPECT_EQ(c.State(), ControllerState::kFailed);
@@ -153,9 +154,7 @@ TEST(LcCrossingController, BarrierNotDownFailsAndNeverReportsClosed) {
   EXPECT_EQ(c.Output().report.status, CrossingStatus::kFailed);
   EXPECT_TRUE(c.Output().lights_on);
   // a late "down" and the withdrawal do not make it closed or end the warning
-  in = Down(kLower + kTimeout + 1'000);
-  in.withdrawals = kTrainA;
-  ASSERT_EQ(c.Cycle(in), ControllerError::kNone);
+  ASSERT_EQ(c.Cycle(Withdrawing(Down(kLower + kTimeout + 1'000), kTrainA)), ControllerError::kNone);
   EXPECT_EQ(c.State(), ControllerState::kFailed);
   EXPECT_EQ(c.Output().report.status, CrossingStatus::kFailed);
   EXPECT_TRUE(c.Output().lights_on);
@@ -169,11 +168,9 @@ TEST(LcCrossingController, BarrierNotDownFailsAndNeverReportsClosed) {
 // @verifies REQ-LC-006
 TEST(LcCrossingController, InconsistentDetectionIsNotDown) {
   CrossingController c = Make();
-  ControllerInput in = At(0);
-  in.requests = kTrainA;
-  ASSERT_EQ(c.Cycle(in), ControllerError::kNone);
+  ASSERT_EQ(c.Cycle(Requesting(At(0), kTrainA)), ControllerError::kNone);
   ASSERT_EQ(c.Cycle(Moving(kLower)), ControllerError::kNone);
-  in = Down(kLower + 1'000);
+  ControllerInput in = Down(kLower + 1'000);
   in.barrier_up = true;
   ASSERT_EQ(c.Cycle(in), ControllerError::kNone);
   EXPECT_EQ(c.State(), ControllerState::kClosing);
@@ -194,9 +191,7 @@ TEST(LcCrossingController, LossOfDownWhileClosedFails) {
 // @verifies REQ-LC-007
 TEST(LcCrossingController, BarrierNotUpFails) {
   CrossingController c = ClosedByA();
-  ControllerInput in = Down(10'000);
-  in.withdrawals = kTrainA;
-  ASSERT_EQ(c.Cycle(in), ControllerError::kNone);
+  ASSERT_EQ(c.Cycle(Withdrawing(Down(10'000), kTrainA)), ControllerError::kNone);
   ASSERT_EQ(c.State(), ControllerState::kOpening);
   ASSERT_EQ(c.Cycle(Moving(10'000 + kTimeout - 1)), ControllerError::kNone);
   EXPECT_EQ(c.State(), ControllerState::kOpening);
@@ -210,31 +205,23 @@ TEST(LcCrossingController, BarrierNotUpFails) {
 // @verifies REQ-LC-007
 TEST(LcCrossingController, TwoRequestersBothMustWithdraw) {
   CrossingController c = Make();
-  ControllerInput in = At(0);
-  in.requests = kTrainsAB;
-  ASSERT_EQ(c.Cycle(in), ControllerError::kNone);
+  ASSERT_EQ(c.Cycle(Requesting(At(0), kTrainsAB)), ControllerError::kNone);
   ASSERT_EQ(c.Cycle(Moving(kLower)), ControllerError::kNone);
   ASSERT_EQ(c.Cycle(Down(9'000)), ControllerError::kNone);
   ASSERT_EQ(c.State(), ControllerState::kClosed);
   EXPECT_EQ(c.Status().Requesters().size(), 2U);
 
-  in = Down(10'000);
-  in.withdrawals = kTrainA;
-  ASSERT_EQ(c.Cycle(in), ControllerError::kNone);
+  ASSERT_EQ(c.Cycle(Withdrawing(Down(10'000), kTrainA)), ControllerError::kNone);
   EXPECT_EQ(c.State(), ControllerState::kClosed);
   EXPECT_EQ(c.Output().report.status, CrossingStatus::kClosed);
   ASSERT_EQ(c.Status().Requesters().size(), 1U);
   EXPECT_EQ(c.Status().Requesters()[0], 102U);
   // A repeats its withdrawal (lost ack): acknowledged again, still closed
-  in = Down(10'500);
-  in.withdrawals = kTrainA;
-  ASSERT_EQ(c.Cycle(in), ControllerError::kNone);
+  ASSERT_EQ(c.Cycle(Withdrawing(Down(10'500), kTrainA)), ControllerError::kNone);
   EXPECT_EQ(c.State(), ControllerState::kClosed);
   EXPECT_EQ(c.Output().WithdrawalAcks().size(), 1U);
 
-  in = Down(11'000);
-  in.withdrawals = kTrainB;
-  ASSERT_EQ(c.Cycle(in), ControllerError::kNone);
+  ASSERT_EQ(c.Cycle(Withdrawing(Down(11'000), kTrainB)), ControllerError::kNone);
   EXPECT_EQ(c.State(), ControllerState::kOpening);
 }
 
@@ -242,13 +229,9 @@ TEST(LcCrossingController, TwoRequestersBothMustWithdraw) {
 // @verifies REQ-LC-007
 TEST(LcCrossingController, RequestWhileOpeningRestartsTheWarning) {
   CrossingController c = ClosedByA();
-  ControllerInput in = Down(10'000);
-  in.withdrawals = kTrainA;
-  ASSERT_EQ(c.Cycle(in), ControllerError::kNone);
+  ASSERT_EQ(c.Cycle(Withdrawing(Down(10'000), kTrainA)), ControllerError::kNone);
   ASSERT_EQ(c.State(), ControllerState::kOpening);
-  in = Moving(11'000);
-  in.requests = kTrainB;
-  ASSERT_EQ(c.Cycle(in), ControllerError::kNone);
+  ASSERT_EQ(c.Cycle(Requesting(Moving(11'000), kTrainB)), ControllerError::kNone);
   EXPECT_EQ(c.State(), ControllerState::kWarning);
   EXPECT_EQ(c.Status().warning_start_ms, 11'000);
   EXPECT_EQ(c.Status().episode_start_ms, 0);  // the lights never went off
@@ -266,9 +249,7 @@ TEST(LcCrossingController, AlarmAfterMaxWarningDoesNotEndIt) {
   EXPECT_TRUE(c.Status().alarm);
   EXPECT_EQ(c.State(), ControllerState::kClosed);
   EXPECT_EQ(c.Output().report.status, CrossingStatus::kClosed);
-  ControllerInput in = Down(kMaxWarning + 2);
-  in.withdrawals = kTrainA;
-  ASSERT_EQ(c.Cycle(in), ControllerError::kNone);
+  ASSERT_EQ(c.Cycle(Withdrawing(Down(kMaxWarning + 2), kTrainA)), ControllerError::kNone);
   EXPECT_TRUE(c.Output().alarm);
   ASSERT_EQ(c.Cycle(At(kMaxWarning + 3)), ControllerError::kNone);
   EXPECT_EQ(c.State(), ControllerState::kOpen);
@@ -280,9 +261,7 @@ TEST(LcCrossingController, AlarmAfterMaxWarningDoesNotEndIt) {
 // @verifies REQ-LC-007
 TEST(LcCrossingController, UnknownWithdrawalAcknowledged) {
   CrossingController c = Make();
-  ControllerInput in = At(0);
-  in.withdrawals = kTrainB;
-  ASSERT_EQ(c.Cycle(in), ControllerError::kNone);
+  ASSERT_EQ(c.Cycle(Withdrawing(At(0), kTrainB)), ControllerError::kNone);
   EXPECT_EQ(c.State(), ControllerState::kOpen);
   ASSERT_EQ(c.Output().WithdrawalAcks().size(), 1U);
   EXPECT_EQ(c.Output().WithdrawalAcks()[0], 102U);
@@ -295,6 +274,13 @@ TEST(LcCrossingController, UnknownWithdrawalAcknowledged) {
 ControllerInput WithStart(ControllerInput in, const std::array<StartTimeMessage, 1>& m) {
   in.start_times = m;
   return in;
+}
+
+// Departure 5's start time 100,000 stored at 0 (the crossing still open).
+CrossingController StartStoredAt0() {
+  CrossingController c = Make();
+  EXPECT_EQ(c.Cycle(WithStart(At(0), {{{kId, 5, 100'000}}})), ControllerError::kNone);
+  return c;
 }
 
 // @verifies REQ-LC-009
@@ -347,8 +333,7 @@ TEST(LcCrossingController, StoredStartTimeStartsTheWarning) {
 
 // @verifies REQ-LC-010
 TEST(LcCrossingController, EarlierAlwaysLaterOnlyBeforeTheWarning) {
-  CrossingController c = Make();
-  ASSERT_EQ(c.Cycle(WithStart(At(0), {{{kId, 5, 100'000}}})), ControllerError::kNone);
+  CrossingController c = StartStoredAt0();
   // later while open and not yet due: taken
   ASSERT_EQ(c.Cycle(WithStart(At(1'000), {{{kId, 5, 120'000}}})), ControllerError::kNone);
   EXPECT_EQ(c.Status().pending.start_ms, 120'000);
@@ -376,11 +361,8 @@ TEST(LcCrossingController, EarlierAlwaysLaterOnlyBeforeTheWarning) {
 // @verifies REQ-LC-010
 // @verifies REQ-LC-014
 TEST(LcCrossingController, LaterUpdateRefusedWhileWarningForARequest) {
-  CrossingController c = Make();
-  ASSERT_EQ(c.Cycle(WithStart(At(0), {{{kId, 5, 100'000}}})), ControllerError::kNone);
-  ControllerInput in = At(1'000);
-  in.requests = kTrainA;
-  ASSERT_EQ(c.Cycle(in), ControllerError::kNone);
+  CrossingController c = StartStoredAt0();
+  ASSERT_EQ(c.Cycle(Requesting(At(1'000), kTrainA)), ControllerError::kNone);
   ASSERT_EQ(c.State(), ControllerState::kWarning);
   ASSERT_EQ(c.Cycle(WithStart(At(2'000), {{{kId, 5, 200'000}}})), ControllerError::kNone);
   EXPECT_EQ(c.Status().pending.start_ms, 100'000);
@@ -388,9 +370,7 @@ TEST(LcCrossingController, LaterUpdateRefusedWhileWarningForARequest) {
   ASSERT_EQ(c.Cycle(Down(9'000)), ControllerError::kNone);  // closing
   ASSERT_EQ(c.Cycle(Down(9'500)), ControllerError::kNone);  // closed
   ASSERT_EQ(c.State(), ControllerState::kClosed);
-  in = Down(10'000);
-  in.withdrawals = kTrainA;
-  ASSERT_EQ(c.Cycle(in), ControllerError::kNone);
+  ASSERT_EQ(c.Cycle(Withdrawing(Down(10'000), kTrainA)), ControllerError::kNone);
   ASSERT_EQ(c.State(), ControllerState::kOpening);
   ASSERT_EQ(c.Cycle(At(11'000)), ControllerError::kNone);
   ASSERT_EQ(c.State(), ControllerState::kOpen);
@@ -402,8 +382,7 @@ TEST(LcCrossingController, LaterUpdateRefusedWhileWarningForARequest) {
 // @verifies REQ-LC-009
 // @verifies REQ-LC-014
 TEST(LcCrossingController, AnotherDepartureWaitsForThePendingOne) {
-  CrossingController c = Make();
-  ASSERT_EQ(c.Cycle(WithStart(At(0), {{{kId, 5, 100'000}}})), ControllerError::kNone);
+  CrossingController c = StartStoredAt0();
   ASSERT_EQ(c.Cycle(WithStart(At(1'000), {{{kId, 6, 50'000}}})), ControllerError::kNone);
   EXPECT_EQ(c.Status().pending.departure_id, 5U);
   EXPECT_EQ(c.Status().pending.start_ms, 100'000);
@@ -512,9 +491,7 @@ TEST(LcCrossingController, RequesterOverflowKeepsWarning) {
   for (std::uint32_t t = 1; t <= kMaxRequesters + 1; ++t) {
     trains.push_back(t);
   }
-  ControllerInput in = At(0);
-  in.requests = trains;
-  ASSERT_EQ(c.Cycle(in), ControllerError::kNone);
+  ASSERT_EQ(c.Cycle(Requesting(At(0), trains)), ControllerError::kNone);
   EXPECT_TRUE(c.Status().requester_overflow);
   ASSERT_EQ(c.Cycle(Moving(kLower)), ControllerError::kNone);
   ASSERT_EQ(c.Cycle(Down(9'000)), ControllerError::kNone);
@@ -525,9 +502,8 @@ TEST(LcCrossingController, RequesterOverflowKeepsWarning) {
   EXPECT_TRUE(c.Output().report.Lists(1));
   EXPECT_TRUE(c.Output().report.Lists(static_cast<std::uint32_t>(kMaxRequesters)));
   EXPECT_FALSE(c.Output().report.Lists(static_cast<std::uint32_t>(kMaxRequesters + 1)));
-  in = Down(10'000);
-  in.withdrawals = std::span<const std::uint32_t>(trains.data(), kMaxRequesters);
-  ASSERT_EQ(c.Cycle(in), ControllerError::kNone);
+  const std::span<const std::uint32_t> stored(trains.data(), kMaxRequesters);
+  ASSERT_EQ(c.Cycle(Withdrawing(Down(10'000), stored)), ControllerError::kNone);
   EXPECT_TRUE(c.Status().Requesters().empty());
   EXPECT_EQ(c.State(), ControllerState::kClosed);
   EXPECT_EQ(c.Output().report.requester_count, 0U);

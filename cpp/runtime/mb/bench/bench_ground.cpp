@@ -16,6 +16,7 @@
 
 #include "railproof/generated/mb_params.hpp"
 #include "railproof/mb/wayside/ground.hpp"
+#include "../tests/line_data.hpp"
 
 namespace {
 
@@ -27,15 +28,10 @@ constexpr std::int64_t kBlocks = 10'000;
 constexpr std::int64_t kBlockMm = 50'000;
 constexpr std::int64_t kLineMm = kBlocks * kBlockMm;  // 500 km
 
-struct BenchLine {
-  std::vector<std::int64_t> blocks;
-  std::vector<Section> fixed;
-  std::vector<Section> no_stop;
-  std::vector<PointsConfig> points;
-  std::vector<RouteConfig> routes;
-  std::vector<HandoverConfig> handovers;
-
+struct BenchLine : railproof::mb::wayside::test::LineData {
   BenchLine() {
+    base.length_mm = kLineMm;
+    boundary = kLineMm - 1'000'000;
     for (std::int64_t b = 0; b <= kBlocks; ++b) {
       blocks.push_back(b * kBlockMm);
     }
@@ -55,19 +51,6 @@ struct BenchLine {
     for (std::int64_t km = 3; km < 500; km += 25) {  // a few no-stop sections
       no_stop.push_back(Section{km * 1'000'000 + 500'000, km * 1'000'000 + 600'000});
     }
-  }
-
-  [[nodiscard]] LineConfig Config() const {
-    LineConfig c = railproof::mb::wayside::DefaultLineParameters();
-    c.length_mm = kLineMm;
-    c.blocks_mm = blocks;
-    c.fixed_blocks = fixed;
-    c.no_stop_sections = no_stop;
-    c.points = points;
-    c.routes = routes;
-    c.handovers = handovers;
-    c.system_boundary_mm = kLineMm - 1'000'000;
-    return c;
   }
 };
 

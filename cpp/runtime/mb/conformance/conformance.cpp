@@ -21,108 +21,63 @@
 // On a mismatch the failure names the vector, the step, the field, expected and actual.
 // Last line: "railproof-conformance-mb: all N vectors passed" or
 // "railproof-conformance-mb: vectors mismatched: K of N" or "...: error: <reason>".
-#include <gtest/gtest.h>
-
-#include <algorithm>
-#include <atomic>
+#include <cstddef>
 #include <cstdint>
-#include <cstdio>
-#include <cstring>
-#include <filesystem>
-#include <fstream>
-#include <memory>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <optional>
-#include <set>
-#include <sstream>
 #include <string>
 #include <utility>
 #include <vector>
 
-#include "railproof/testing/jsonl_vectors.hpp"
-#include "railproof/testing/runner_cli.hpp"
 #include "railproof/mb/onboard/authority.hpp"
 #include "railproof/mb/wayside/ground.hpp"
+#include "railproof/testing/jsonl_runner.hpp"
+#include "../tests/line_data.hpp"
 
 namespace rcli = railproof::conformance;
 
 namespace {
 
-namespace fs = std::filesystem;
 namespace rw = railproof::mb::wayside;
 namespace ro = railproof::mb::onboard;
 using json = nlohmann::json;
+using railproof::mb::wayside::test::LineData;
 
 constexpr std::uint32_t kMainRouteId = 1;
 constexpr std::uint32_t kSidingRouteId = 2;
 constexpr std::uint32_t kHandoverId = 1;
 
 struct Header {
-  std::string file;
-  std::string configuration;
   std::int64_t tick_ms = 0;
   json p;  // parameters
 };
 
-struct Vector {
-  std::string id;
-  std::string test_name;
-  std::size_t header = 0;
-  std::size_t line = 0;
-  json steps;
-};
+std::map<std::string, Header> g_headers;  // per file
 
-std::vector<Header> g_headers;
-std::vector<Vector> g_vectors;
-std::atomic<std::size_t> g_mismatched{0};
-std::atomic<std::size_t> g_replayed{0};
-
-
-// Loads every mb*.jsonl of dir; error names file and line.
-bool Load(const fs::path& dir, std::string& error) {
-  std::size_t files = 0;
-  error = rcli::ReadVectorDirectory(
-      dir, "mb",
-      [](const std::string& file, const json& obj) -> std::string {
-        if (obj.value("kind", "") != "header" || obj.value("model", "") != "models/mb.pml" ||
-            !obj.contains("parameters") || !obj.contains("unit_scales")) {
-          return "first line is not a models/mb.pml vector header";
-        }
-        Header h;
-        h.file = file;
-        h.configuration = obj.value("configuration", "default");
-        h.tick_ms = obj["unit_scales"].value("time_ms_per_tick", std::int64_t{0});
-        h.p = obj["parameters"];
-        if (h.tick_ms <= 0) {
-          return "unit_scales.time_ms_per_tick must be positive";
-        }
-        g_headers.push_back(std::move(h));
-        return "";
-      },
-      [](const rcli::VectorLine& line) -> std::string {
-        g_vectors.push_back(Vector{line.id, line.test_name, g_headers.size() - 1, line.line, (*line.obj)["steps"]});
-        return "";
-      },
-      files);
-  return error.empty();
+// A file's header: the time scale and the parameters of its vectors.
+std::string ReadHeader(const std::string& file, const json& obj) {
+  if (!obj.contains("unit_scales")) {
+    return "first line is not a models/mb.pml vector header";
+  }
+  Header h;
+  h.tick_ms = obj["unit_scales"].value("time_ms_per_tick", std::int64_t{0});
+  h.p = obj["parameters"];
+  if (h.tick_ms <= 0) {
+    return "unit_scales.time_ms_per_tick must be positive";
+  }
+  g_headers[file] = std::move(h);
+  return "";
 }
-
-// The model's line as a ground configuration (design note §2 mapping).
-struct LineData {
-  std::vector<std::int64_t> blocks;
-  std::vector<rw::Section> fixed;
-  std::vector<rw::PointsConfig> points;
-  std::vector<rw::RouteConfig> routes;
-  std::vector<rw::HandoverConfig> handovers;
-  rw::LineConfig line{};
-};
 
 rw::Section SectionOf(const json& a) { return rw::Section{a.at(0).get<std::int64_t>(), a.at(1).get<std::int64_t>()}; }
 
+// The model's line as a ground configuration (design note §2 mapping).
 void BuildLine(const Header& h, LineData& d) {
   const json& p = h.p;
   d.blocks = p.at("blocks_mm").get<std::vector<std::int64_t>>();
   d.fixed = {SectionOf(p.at("platform_mm"))};
+  d.setback = d.fixed;  // the platform is the set-back section
   d.points = {rw::PointsConfig{1, SectionOf(p.at("points_mm"))}};
   const rw::Section main = SectionOf(p.at("route_main_mm"));
   const rw::Section pts = SectionOf(p.at("points_mm"));
@@ -130,17 +85,9 @@ void BuildLine(const Header& h, LineData& d) {
               rw::RouteConfig{kSidingRouteId, pts.begin_mm, pts.end_mm, 0, true, false}};
   d.handovers = {rw::HandoverConfig{kHandoverId, p.at("handover_mm").get<std::int64_t>()}};
   const json& m = p.at("margins_mm");
-  rw::LineConfig& l = d.line;
-  l = rw::DefaultLineParameters();
+  d.boundary = p.at("boundary_mm").get<std::int64_t>();
+  rw::LineConfig& l = d.base;
   l.length_mm = p.at("line_mm").get<std::int64_t>();
-  l.blocks_mm = d.blocks;
-  l.fixed_blocks = d.fixed;
-  l.setback_sections = d.fixed;  // the platform is the set-back section
-  l.no_stop_sections = {};
-  l.points = d.points;
-  l.routes = d.routes;
-  l.handovers = d.handovers;
-  l.system_boundary_mm = p.at("boundary_mm").get<std::int64_t>();
   l.margins = rw::Margins{m.at("train").get<std::int64_t>(),    m.at("fixed_block").get<std::int64_t>(),
                           m.at("route").get<std::int64_t>(),    m.at("handover").get<std::int64_t>(),
                           m.at("boundary").get<std::int64_t>(), m.at("possession").get<std::int64_t>(),
@@ -161,197 +108,165 @@ const char* PossessionName(rw::PossessionState s) {
   return "INVALID";
 }
 
-std::string Opt(const std::optional<std::int64_t>& v) { return v ? std::to_string(*v) : "null"; }
-std::string Opt(const json& v) { return v.is_null() ? "null" : std::to_string(v.get<std::int64_t>()); }
+using rcli::Bool;
+using rcli::OptInt;
 
-class VectorTest : public testing::Test {
- public:
-  explicit VectorTest(std::size_t index) : index_(index) {}
-  void TestBody() override {
-    const Vector& v = g_vectors[index_];
-    const Header& h = g_headers[v.header];
-    g_replayed.fetch_add(1);
-    RecordProperty("vector_id", v.id);
-    std::vector<std::string> problems;
-    Replay(v, h, problems);
-    if (!problems.empty()) {
-      g_mismatched.fetch_add(1);
-    }
-    for (const std::string& p : problems) {
-      ADD_FAILURE_AT(h.file.c_str(), static_cast<int>(v.line)) << "vector " << v.id << ": " << p;
-    }
+void Replay(const rcli::JsonVector& v, std::vector<std::string>& problems) {
+  const Header& h = g_headers.at(v.file);
+  LineData d;
+  BuildLine(h, d);
+  const auto fronts = h.p.at("initial_front_mm").get<std::vector<std::int64_t>>();
+  const auto corrs = h.p.at("initial_correction_mm").get<std::vector<std::int64_t>>();
+  rw::Capacity cap = rw::DefaultCapacity();
+  cap.trains = fronts.size();
+  cap.blocks = d.blocks.size() - 1;
+  auto created = rw::Ground::Create(d.Config(), cap, 0);
+  if (created.error != rw::ConfigError::kNone) {
+    problems.push_back(std::string("ground configuration refused: ") + ToString(created.error) +
+                       " entry " + std::to_string(created.entry));
+    return;
   }
-
- private:
-  static void Replay(const Vector& v, const Header& h, std::vector<std::string>& problems) {
-    LineData d;
-    BuildLine(h, d);
-    const auto fronts = h.p.at("initial_front_mm").get<std::vector<std::int64_t>>();
-    const auto corrs = h.p.at("initial_correction_mm").get<std::vector<std::int64_t>>();
-    rw::Capacity cap = rw::DefaultCapacity();
-    cap.trains = fronts.size();
-    cap.blocks = d.blocks.size() - 1;
-    auto created = rw::Ground::Create(d.line, cap, 0);
-    if (created.error != rw::ConfigError::kNone) {
-      problems.push_back(std::string("ground configuration refused: ") + ToString(created.error) +
-                         " entry " + std::to_string(created.entry));
+  rw::Ground& g = *created.ground;
+  const std::int64_t length = h.p.at("train_length_mm").get<std::int64_t>();
+  std::vector<ro::AuthorityReceiver> onboard;
+  const ro::AuthorityConfig acfg{h.p.at("validity_ms").get<std::int64_t>(), h.p.at("max_age_ms").get<std::int64_t>()};
+  for (std::size_t t = 0; t < fronts.size(); ++t) {
+    const auto st = g.RegisterTrain(rw::TrainRegistration{static_cast<std::uint32_t>(t), length, fronts[t], corrs[t],
+                                                          rw::InitialPosition::kStabledProvisional});
+    if (st != rw::RegisterStatus::kRegistered) {
+      problems.push_back("train " + std::to_string(t) + " not registered");
       return;
     }
-    rw::Ground& g = *created.ground;
-    const std::int64_t length = h.p.at("train_length_mm").get<std::int64_t>();
-    std::vector<ro::AuthorityReceiver> onboard;
-    const ro::AuthorityConfig acfg{h.p.at("validity_ms").get<std::int64_t>(), h.p.at("max_age_ms").get<std::int64_t>()};
+    onboard.emplace_back(acfg);
+  }
+  if (h.p.at("secured_at_start").get<bool>()) {
     for (std::size_t t = 0; t < fronts.size(); ++t) {
-      const auto st = g.RegisterTrain(rw::TrainRegistration{static_cast<std::uint32_t>(t), length, fronts[t], corrs[t],
-                                                            rw::InitialPosition::kStabledProvisional});
-      if (st != rw::RegisterStatus::kRegistered) {
-        problems.push_back("train " + std::to_string(t) + " not registered");
-        return;
-      }
-      onboard.emplace_back(acfg);
-    }
-    if (h.p.at("secured_at_start").get<bool>()) {
-      for (std::size_t t = 0; t < fronts.size(); ++t) {
-        g.SecureHandover(static_cast<std::uint32_t>(t), kHandoverId);
-      }
-    }
-    if (h.p.at("boundary_accepted_at_start").get<bool>()) {
-      g.AcceptAtBoundary(true);
-    }
-    std::optional<std::uint32_t> possession_id;
-    std::int64_t now = 0;
-    const auto& poss_range = h.p.at("possession_mm");
-    for (std::size_t k = 0; k < v.steps.size() && problems.empty(); ++k) {
-      const json& in = v.steps[k].at("in");
-      const json& out = v.steps[k].at("out");
-      const std::string ev = in.at("ev").get<std::string>();
-      auto expect = [&](const std::string& field, const std::string& expected, const std::string& actual) {
-        if (expected != actual) {
-          problems.push_back("step " + std::to_string(k) + " (" + ev + "): " + field + " expected " + expected +
-                             ", got " + actual);
-        }
-      };
-      if (ev == "cmd") {
-        const std::string cmd = in.at("cmd").get<std::string>();
-        if (cmd == "POSSESSION_REQUEST") {
-          const auto r = g.RequestPossession(SectionOf(poss_range));
-          if (r.status == rw::CommandStatus::kAccepted) {
-            possession_id = r.id;
-          }
-        } else if (cmd == "POSSESSION_CANCEL") {
-          if (possession_id) {
-            g.CancelPossession(*possession_id);
-          }
-        } else if (cmd == "SIDING_REQUEST") {
-          g.RequestRoute(kSidingRouteId);
-        } else if (cmd == "SIDING_FREE") {
-          expect("FreeRoute", "accepted",
-                 g.FreeRoute(kSidingRouteId) == rw::CommandStatus::kAccepted ? "accepted" : "refused");
-        } else if (cmd == "SECURE") {
-          g.SecureHandover(in.at("train").get<std::uint32_t>(), kHandoverId);
-        } else if (cmd == "BOUNDARY_ACCEPT") {
-          g.AcceptAtBoundary(true);
-        } else {
-          problems.push_back("step " + std::to_string(k) + ": unknown command " + cmd);
-          break;
-        }
-        const auto ps = possession_id ? g.Possession(*possession_id) : rw::PossessionState::kNone;
-        expect("possession", out.at("possession").get<std::string>(), PossessionName(ps));
-        expect("siding_requested", out.at("siding_requested").get<bool>() ? "true" : "false",
-               g.RouteRequested(kSidingRouteId) ? "true" : "false");
-      } else if (ev == "report") {
-        const auto t = in.at("train").get<std::uint32_t>();
-        const std::int64_t front = in.at("front_mm").get<std::int64_t>();
-        const auto loc = g.LocateFront(front);
-        if (!loc) {
-          problems.push_back("step " + std::to_string(k) + ": front " + std::to_string(front) + " not on the line");
-          break;
-        }
-        rw::PositionReport r{};
-        r.train_id = t;
-        r.front_block = loc->block;
-        r.offset_mm = loc->offset_mm;
-        r.length_mm = length;
-        r.correction_mm = in.at("correction_mm").get<std::int64_t>();
-        r.last_balise_mm = 0;
-        r.speed_mm_s = 0;
-        r.direction = rw::Direction::kNominal;
-        const auto st = g.OnReport(r);
-        expect("tracked", out.at("tracked").get<bool>() ? "accepted" : "rejected",
-               st == rw::ReportStatus::kAccepted ? "accepted" : std::string("rejected ") + ToString(st));
-      } else if (ev == "tick") {
-        now += h.tick_ms;
-        g.Cycle(now);
-        const json& trains = out.at("trains");
-        for (std::size_t t = 0; t < trains.size(); ++t) {
-          const auto o = g.Train(static_cast<std::uint32_t>(t));
-          const std::string pre = "train " + std::to_string(t) + " ";
-          if (!o) {
-            problems.push_back("step " + std::to_string(k) + ": " + pre + "unknown to the ground");
-            continue;
-          }
-          expect(pre + "abnormal", trains[t].at("abnormal").get<bool>() ? "true" : "false", o->abnormal ? "true" : "false");
-          expect(pre + "limit_mm", Opt(trains[t].at("limit_mm")), Opt(o->limit_mm));
-          expect(pre + "kind", trains[t].at("kind").get<std::string>(), ToString(o->kind));
-          // the on-board authority is still usable at this cycle (before its deliveries)
-          expect(pre + "authority_usable", trains[t].at("authority_usable").get<bool>() ? "true" : "false",
-                 onboard[t].Usable(now) ? "true" : "false");
-        }
-        expect("main_route", out.at("main_route").get<bool>() ? "set" : "unset", g.RouteSet(kMainRouteId) ? "set" : "unset");
-        expect("siding_route", out.at("siding_route").get<bool>() ? "set" : "unset",
-               g.RouteSet(kSidingRouteId) ? "set" : "unset");
-        expect("points_reverse", out.at("points_reverse").get<bool>() ? "true" : "false",
-               g.PointsReverse(0) ? "true" : "false");
-        const auto ps = possession_id ? g.Possession(*possession_id) : rw::PossessionState::kNone;
-        expect("possession", out.at("possession").get<std::string>(), PossessionName(ps));
-        std::string occ_expected;
-        for (const auto& b : out.at("occupied")) {
-          occ_expected += std::to_string(b.get<std::int64_t>()) + " ";
-        }
-        std::string occ_actual;
-        for (std::size_t b = 0; b < g.BlockCount(); ++b) {
-          if (g.BlockOccupied(b)) {
-            occ_actual += std::to_string(b) + " ";
-          }
-        }
-        expect("occupied blocks", "[" + occ_expected + "]", "[" + occ_actual + "]");
-      } else if (ev == "deliver") {
-        const auto t = in.at("train").get<std::size_t>();
-        if (t >= onboard.size()) {
-          problems.push_back("step " + std::to_string(k) + ": unknown train " + std::to_string(t));
-          break;
-        }
-        const std::int64_t issue = now - in.at("age_ms").get<std::int64_t>();
-        const auto verdict = onboard[t].Receive(in.at("limit_mm").get<std::int64_t>(), issue, now);
-        expect("verdict", out.at("verdict").get<std::string>(), ToString(verdict));
-        expect("on-board limit_mm", Opt(out.at("limit_mm")), Opt(onboard[t].Limit()));
-      } else {
-        problems.push_back("step " + std::to_string(k) + ": unknown event " + ev);
-      }
+      g.SecureHandover(static_cast<std::uint32_t>(t), kHandoverId);
     }
   }
-
-  std::size_t index_;
-};
+  if (h.p.at("boundary_accepted_at_start").get<bool>()) {
+    g.AcceptAtBoundary(true);
+  }
+  std::optional<std::uint32_t> possession_id;
+  std::int64_t now = 0;
+  const auto& poss_range = h.p.at("possession_mm");
+  for (std::size_t k = 0; k < v.steps.size() && problems.empty(); ++k) {
+    const json& in = v.steps[k].at("in");
+    const json& out = v.steps[k].at("out");
+    const std::string ev = in.at("ev").get<std::string>();
+    rcli::Checker chk(problems, "step " + std::to_string(k) + " (" + ev + "): ");
+    if (ev == "cmd") {
+      const std::string cmd = in.at("cmd").get<std::string>();
+      if (cmd == "POSSESSION_REQUEST") {
+        const auto r = g.RequestPossession(SectionOf(poss_range));
+        if (r.status == rw::CommandStatus::kAccepted) {
+          possession_id = r.id;
+        }
+      } else if (cmd == "POSSESSION_CANCEL") {
+        if (possession_id) {
+          g.CancelPossession(*possession_id);
+        }
+      } else if (cmd == "SIDING_REQUEST") {
+        g.RequestRoute(kSidingRouteId);
+      } else if (cmd == "SIDING_FREE") {
+        chk.Expect("FreeRoute", "accepted",
+                   g.FreeRoute(kSidingRouteId) == rw::CommandStatus::kAccepted ? "accepted" : "refused");
+      } else if (cmd == "SECURE") {
+        g.SecureHandover(in.at("train").get<std::uint32_t>(), kHandoverId);
+      } else if (cmd == "BOUNDARY_ACCEPT") {
+        g.AcceptAtBoundary(true);
+      } else {
+        problems.push_back("step " + std::to_string(k) + ": unknown command " + cmd);
+        break;
+      }
+      const auto ps = possession_id ? g.Possession(*possession_id) : rw::PossessionState::kNone;
+      chk.Expect("possession", out.at("possession").get<std::string>(), PossessionName(ps));
+      chk.Expect("siding_requested", Bool(out.at("siding_requested").get<bool>()),
+                 Bool(g.RouteRequested(kSidingRouteId)));
+    } else if (ev == "report") {
+      const auto t = in.at("train").get<std::uint32_t>();
+      const std::int64_t front = in.at("front_mm").get<std::int64_t>();
+      const auto loc = g.LocateFront(front);
+      if (!loc) {
+        problems.push_back("step " + std::to_string(k) + ": front " + std::to_string(front) + " not on the line");
+        break;
+      }
+      rw::PositionReport r{};
+      r.train_id = t;
+      r.front_block = loc->block;
+      r.offset_mm = loc->offset_mm;
+      r.length_mm = length;
+      r.correction_mm = in.at("correction_mm").get<std::int64_t>();
+      r.last_balise_mm = 0;
+      r.speed_mm_s = 0;
+      r.direction = rw::Direction::kNominal;
+      const auto st = g.OnReport(r);
+      chk.Expect("tracked", out.at("tracked").get<bool>() ? "accepted" : "rejected",
+                 st == rw::ReportStatus::kAccepted ? "accepted" : std::string("rejected ") + ToString(st));
+    } else if (ev == "tick") {
+      now += h.tick_ms;
+      g.Cycle(now);
+      const json& trains = out.at("trains");
+      for (std::size_t t = 0; t < trains.size(); ++t) {
+        const auto o = g.Train(static_cast<std::uint32_t>(t));
+        const std::string pre = "train " + std::to_string(t) + " ";
+        if (!o) {
+          problems.push_back("step " + std::to_string(k) + ": " + pre + "unknown to the ground");
+          continue;
+        }
+        chk.Expect(pre + "abnormal", Bool(trains[t].at("abnormal").get<bool>()), Bool(o->abnormal));
+        chk.Expect(pre + "limit_mm", OptInt(trains[t].at("limit_mm")), OptInt(o->limit_mm));
+        chk.Expect(pre + "kind", trains[t].at("kind").get<std::string>(), ToString(o->kind));
+        // the on-board authority is still usable at this cycle (before its deliveries)
+        chk.Expect(pre + "authority_usable", Bool(trains[t].at("authority_usable").get<bool>()),
+                   Bool(onboard[t].Usable(now)));
+      }
+      chk.Expect("main_route", out.at("main_route").get<bool>() ? "set" : "unset",
+                 g.RouteSet(kMainRouteId) ? "set" : "unset");
+      chk.Expect("siding_route", out.at("siding_route").get<bool>() ? "set" : "unset",
+                 g.RouteSet(kSidingRouteId) ? "set" : "unset");
+      chk.Expect("points_reverse", Bool(out.at("points_reverse").get<bool>()), Bool(g.PointsReverse(0)));
+      const auto ps = possession_id ? g.Possession(*possession_id) : rw::PossessionState::kNone;
+      chk.Expect("possession", out.at("possession").get<std::string>(), PossessionName(ps));
+      std::string occ_expected;
+      for (const auto& b : out.at("occupied")) {
+        occ_expected += std::to_string(b.get<std::int64_t>()) + " ";
+      }
+      std::string occ_actual;
+      for (std::size_t b = 0; b < g.BlockCount(); ++b) {
+        if (g.BlockOccupied(b)) {
+          occ_actual += std::to_string(b) + " ";
+        }
+      }
+      chk.Expect("occupied blocks", "[" + occ_expected + "]", "[" + occ_actual + "]");
+    } else if (ev == "deliver") {
+      const auto t = in.at("train").get<std::size_t>();
+      if (t >= onboard.size()) {
+        problems.push_back("step " + std::to_string(k) + ": unknown train " + std::to_string(t));
+        break;
+      }
+      const std::int64_t issue = now - in.at("age_ms").get<std::int64_t>();
+      const auto verdict = onboard[t].Receive(in.at("limit_mm").get<std::int64_t>(), issue, now);
+      chk.Expect("verdict", out.at("verdict").get<std::string>(), ToString(verdict));
+      chk.Expect("on-board limit_mm", OptInt(out.at("limit_mm")), OptInt(onboard[t].Limit()));
+    } else {
+      problems.push_back("step " + std::to_string(k) + ": unknown event " + ev);
+    }
+  }
+}
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  return rcli::RunnerMain(
-      "railproof-conformance-mb", "MovingBlockConformance",
-      "Replays every mb*.jsonl vector of DIR against the C++ ground and on-board units.", argc, argv,
-      [](const std::string& dir) {
-        std::string error;
-        const bool ok = Load(dir, error);
-        std::set<std::string> files;
-        for (const Header& h : g_headers) {
-          files.insert(h.file);
-        }
-        return rcli::LoadedSet{ok, error, g_vectors.size(), files.size()};
-      },
-      [](std::size_t i) {
-        const Vector& v = g_vectors[i];
-        return rcli::VectorSite{v.test_name, g_headers[v.header].file, static_cast<int>(v.line)};
-      },
-      [](std::size_t i) -> testing::Test* { return new VectorTest(i); }, g_mismatched, g_replayed);
+  return rcli::RunJsonVectors(
+      {.prog = "railproof-conformance-mb",
+       .suite = "MovingBlockConformance",
+       .description = "Replays every mb*.jsonl vector of DIR against the C++ ground and on-board units.",
+       .prefix = "mb",
+       .models = {"models/mb.pml"},
+       .units = "",  // the header states none
+       .header = ReadHeader,
+       .step_ok = nullptr,  // the replay reads each step with at()
+       .replay = Replay},
+      argc, argv);
 }

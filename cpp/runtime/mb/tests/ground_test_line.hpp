@@ -8,11 +8,15 @@
 #include <gtest/gtest.h>
 
 #include <cstdint>
+#include <initializer_list>
 #include <memory>
 #include <optional>
+#include <ostream>
+#include <string>
 #include <utility>
 #include <vector>
 
+#include "line_data.hpp"
 #include "railproof/mb/wayside/ground.hpp"
 
 namespace railproof::mb::wayside::test {
@@ -23,18 +27,8 @@ inline constexpr std::int64_t kTrainLen = 100'000;
 inline constexpr Margins kMargins{20'000, 21'000, 30'000, 22'000, 23'000, 50'000, 40'000, 10'000};
 inline constexpr std::int64_t kEot = kLen - 10'000;  // END_OF_TRACK limit
 
-struct TestLine {
-  std::vector<std::int64_t> blocks;
-  std::vector<Section> fixed;
-  std::vector<Section> setback;
-  std::vector<Section> no_stop;
-  std::vector<PointsConfig> points;
-  std::vector<RouteConfig> routes;
-  std::vector<HandoverConfig> handovers;
-  std::optional<std::int64_t> boundary;
-  LineConfig base;
-
-  TestLine() : base(DefaultLineParameters()) {
+struct TestLine : LineData {
+  TestLine() {
     base.length_mm = kLen;
     base.margins = kMargins;
     for (std::int64_t x = 0; x <= kLen; x += kBlock) {
@@ -49,19 +43,6 @@ struct TestLine {
     routes.push_back(RouteConfig{1, 1'000'000, 1'100'000, 0, false, true});
     routes.push_back(RouteConfig{2, 1'000'000, 1'100'000, 0, true, false});
     return *this;
-  }
-
-  [[nodiscard]] LineConfig Config() const {
-    LineConfig c = base;
-    c.blocks_mm = blocks;
-    c.fixed_blocks = fixed;
-    c.setback_sections = setback;
-    c.no_stop_sections = no_stop;
-    c.points = points;
-    c.routes = routes;
-    c.handovers = handovers;
-    c.system_boundary_mm = boundary;
-    return c;
   }
 };
 
@@ -91,6 +72,16 @@ inline RegisterStatus Register(Ground& g, std::uint32_t id, std::int64_t front, 
   return g.RegisterTrain(TrainRegistration{id, length, front, corr, initial});
 }
 
+// A ground over `line` with the trains (id, front) registered at their entry balise, in order.
+inline std::unique_ptr<Ground> MakeGround(const TestLine& line,
+                                          std::initializer_list<std::pair<std::uint32_t, std::int64_t>> trains) {
+  auto g = MakeGround(line);
+  for (const auto& [id, front] : trains) {
+    EXPECT_EQ(Register(*g, id, front), RegisterStatus::kRegistered) << "train " << id;
+  }
+  return g;
+}
+
 inline PositionReport MakeReport(const Ground& g, std::uint32_t id, std::int64_t front, std::int64_t corr = 0,
                                  std::int64_t length = kTrainLen) {
   const auto pos = g.LocateFront(front);
@@ -112,6 +103,19 @@ inline Obstruction KindOf(const Ground& g, std::uint32_t id) {
   const auto t = g.Train(id);
   return t.has_value() ? t->kind : Obstruction::kNone;
 }
+
+// A train's stop limit and what limits it, compared and printed together.
+struct LimitAndKind {
+  std::optional<std::int64_t> limit_mm;
+  Obstruction kind = Obstruction::kNone;
+  bool operator==(const LimitAndKind&) const = default;
+};
+
+inline void PrintTo(const LimitAndKind& l, std::ostream* os) {
+  *os << (l.limit_mm ? std::to_string(*l.limit_mm) : std::string("no limit")) << " (" << ToString(l.kind) << ")";
+}
+
+inline LimitAndKind LimitAndKindOf(const Ground& g, std::uint32_t id) { return {LimitOf(g, id), KindOf(g, id)}; }
 
 inline bool AbnormalOf(const Ground& g, std::uint32_t id) {
   const auto t = g.Train(id);

@@ -28,8 +28,9 @@ using test::AbnormalOf;
 using test::kBlock;
 using test::kEot;
 using test::kLen;
-using test::KindOf;
 using test::kTrainLen;
+using test::LimitAndKind;
+using test::LimitAndKindOf;
 using test::LimitOf;
 using test::MakeGround;
 using test::MakeReport;
@@ -194,9 +195,7 @@ TEST(WaysideGroundConfig, RuntimeCapacitiesGiveTypedRejections) {
 
 // @verifies REQ-MB-001
 TEST(WaysideGroundReport, RejectsWithTypedReasonInOrder) {
-  TestLine line;
-  auto g = MakeGround(line);
-  ASSERT_EQ(Register(*g, 1, 550'000), RegisterStatus::kRegistered);
+  auto g = MakeGround(TestLine(), {{1, 550'000}});
   const PositionReport good = MakeReport(*g, 1, 560'000);
   EXPECT_EQ(good.front_block, 11U);
   EXPECT_EQ(good.offset_mm, 10'000);
@@ -237,8 +236,7 @@ TEST(WaysideGroundReport, RejectsWithTypedReasonInOrder) {
 TEST(WaysideGroundReport, BackwardMovementOnlyInsideSetBackSectionAndBounded) {
   TestLine line;
   line.setback = {{500'000, 600'000}};
-  auto g = MakeGround(line);
-  ASSERT_EQ(Register(*g, 1, 550'000), RegisterStatus::kRegistered);
+  auto g = MakeGround(line, {{1, 550'000}});
   EXPECT_EQ(Report(*g, 1, 549'000), ReportStatus::kAccepted);
   EXPECT_EQ(Report(*g, 1, 546'000), ReportStatus::kSetBackTooFar);  // 4000 > 3000 behind 550000
   EXPECT_EQ(Report(*g, 1, 547'000), ReportStatus::kAccepted);       // exactly 3000
@@ -269,9 +267,7 @@ TEST(WaysideGroundReport, BackwardMovementOnlyInsideSetBackSectionAndBounded) {
 // @verifies REQ-MB-001
 // @verifies REQ-MB-004
 TEST(WaysideGroundReport, StampedWithTheLastCycleTime) {
-  TestLine line;
-  auto g = MakeGround(line);
-  ASSERT_EQ(Register(*g, 1, 500'000), RegisterStatus::kRegistered);
+  auto g = MakeGround(TestLine(), {{1, 500'000}});
   ASSERT_EQ(g->Cycle(500), CycleStatus::kDone);
   EXPECT_EQ(g->LastCycleMs(), 500);
   ASSERT_EQ(Report(*g, 1, 510'000), ReportStatus::kAccepted);  // arrives at, say, 990 ms: stamped 500
@@ -283,9 +279,7 @@ TEST(WaysideGroundReport, StampedWithTheLastCycleTime) {
 
 // @verifies REQ-MB-004
 TEST(WaysideGroundReport, ValidReportOfAbnormalTrainRestoresTracking) {
-  TestLine line;
-  auto g = MakeGround(line);
-  ASSERT_EQ(Register(*g, 1, 500'000), RegisterStatus::kRegistered);
+  auto g = MakeGround(TestLine(), {{1, 500'000}});
   ASSERT_EQ(g->Cycle(3001), CycleStatus::kDone);
   ASSERT_TRUE(AbnormalOf(*g, 1));
   EXPECT_TRUE(g->Telegrams().empty());
@@ -305,13 +299,10 @@ TEST(WaysideGroundReport, ValidReportOfAbnormalTrainRestoresTracking) {
 // @verifies REQ-MB-006
 // @verifies REQ-MB-023
 TEST(WaysideGroundLimit, EndOfTrackMinusItsMargin) {
-  TestLine line;
-  auto g = MakeGround(line);
-  ASSERT_EQ(Register(*g, 1, 100'000), RegisterStatus::kRegistered);
+  auto g = MakeGround(TestLine(), {{1, 100'000}});
   EXPECT_FALSE(LimitOf(*g, 1).has_value());  // nothing issued before the first cycle
   ASSERT_EQ(g->Cycle(500), CycleStatus::kDone);
-  EXPECT_EQ(LimitOf(*g, 1), 1'990'000);
-  EXPECT_EQ(KindOf(*g, 1), Obstruction::kEndOfTrack);
+  EXPECT_EQ(LimitAndKindOf(*g, 1), (LimitAndKind{1'990'000, Obstruction::kEndOfTrack}));
 }
 
 // @verifies REQ-MB-006
@@ -319,14 +310,12 @@ TEST(WaysideGroundLimit, EndOfTrackMinusItsMargin) {
 // @verifies REQ-MB-003
 // @verifies REQ-MB-018
 TEST(WaysideGroundLimit, PrecedingTrainExtendedRearMinusTrainMargin) {
-  TestLine line;
-  auto g = MakeGround(line);
+  auto g = MakeGround(TestLine());
   ASSERT_EQ(Register(*g, 1, 1'000'000, 1'000), RegisterStatus::kRegistered);
   ASSERT_EQ(Register(*g, 2, 500'000), RegisterStatus::kRegistered);
   ASSERT_EQ(g->Cycle(500), CycleStatus::kDone);
   // 1000000 - 100000 - 1000 - 20000
-  EXPECT_EQ(LimitOf(*g, 2), 879'000);
-  EXPECT_EQ(KindOf(*g, 2), Obstruction::kPrecedingTrain);
+  EXPECT_EQ(LimitAndKindOf(*g, 2), (LimitAndKind{879'000, Obstruction::kPrecedingTrain}));
   EXPECT_EQ(LimitOf(*g, 1), kEot);
   ASSERT_EQ(Report(*g, 1, 1'100'000, 2'000), ReportStatus::kAccepted);
   ASSERT_EQ(g->Cycle(1000), CycleStatus::kDone);
@@ -336,10 +325,7 @@ TEST(WaysideGroundLimit, PrecedingTrainExtendedRearMinusTrainMargin) {
 // @verifies REQ-MB-004
 // @verifies REQ-MB-006
 TEST(WaysideGroundLimit, AbnormalTrainLastKnownRearMinusAbnormalMargin) {
-  TestLine line;
-  auto g = MakeGround(line);
-  ASSERT_EQ(Register(*g, 1, 1'000'000), RegisterStatus::kRegistered);
-  ASSERT_EQ(Register(*g, 2, 500'000), RegisterStatus::kRegistered);
+  auto g = MakeGround(TestLine(), {{1, 1'000'000}, {2, 500'000}});
   for (std::int64_t now = 500; now <= 3000; now += 500) {
     ASSERT_EQ(g->Cycle(now), CycleStatus::kDone);
     ASSERT_EQ(Report(*g, 2, 500'000), ReportStatus::kAccepted);
@@ -348,11 +334,9 @@ TEST(WaysideGroundLimit, AbnormalTrainLastKnownRearMinusAbnormalMargin) {
   }
   ASSERT_EQ(g->Cycle(3500), CycleStatus::kDone);
   ASSERT_TRUE(AbnormalOf(*g, 1));
-  EXPECT_EQ(LimitOf(*g, 2), 860'000);  // 900000 - 40000
-  EXPECT_EQ(KindOf(*g, 2), Obstruction::kAbnormalTrain);
+  EXPECT_EQ(LimitAndKindOf(*g, 2), (LimitAndKind{860'000, Obstruction::kAbnormalTrain}));  // 900000 - 40000
   // the abnormal train shows its frozen bound, kind NONE, and gets no telegram
-  EXPECT_EQ(LimitOf(*g, 1), kEot);
-  EXPECT_EQ(KindOf(*g, 1), Obstruction::kNone);
+  EXPECT_EQ(LimitAndKindOf(*g, 1), (LimitAndKind{kEot, Obstruction::kNone}));
   ASSERT_EQ(g->Telegrams().size(), 1U);
   EXPECT_EQ(g->Telegrams()[0].train_id, 2U);
 }
@@ -365,26 +349,23 @@ TEST(WaysideGroundLimit, FixedBlockOccupiedByAnotherTrain) {
   ASSERT_EQ(Register(*g, 1, 680'000), RegisterStatus::kRegistered);  // [580000, 680000) in the platform
   ASSERT_EQ(Register(*g, 2, 300'000), RegisterStatus::kRegistered);
   ASSERT_EQ(g->Cycle(500), CycleStatus::kDone);
-  EXPECT_EQ(LimitOf(*g, 2), 479'000);  // 500000 - 21000 < 580000 - 20000
-  EXPECT_EQ(KindOf(*g, 2), Obstruction::kFixedBlock);
+  // 500000 - 21000 < 580000 - 20000
+  EXPECT_EQ(LimitAndKindOf(*g, 2), (LimitAndKind{479'000, Obstruction::kFixedBlock}));
   // front exactly at the block's begin: still applies (front <= begin), limit behind the
   // front (never clamped)
   ASSERT_EQ(Report(*g, 2, 500'000), ReportStatus::kAccepted);
   ASSERT_EQ(g->Cycle(1000), CycleStatus::kDone);
-  EXPECT_EQ(LimitOf(*g, 2), 479'000);
-  EXPECT_EQ(KindOf(*g, 2), Obstruction::kFixedBlock);
+  EXPECT_EQ(LimitAndKindOf(*g, 2), (LimitAndKind{479'000, Obstruction::kFixedBlock}));
   // one millimetre further: the train is in the block itself, only the train ahead counts
   ASSERT_EQ(Report(*g, 2, 500'001), ReportStatus::kAccepted);
   ASSERT_EQ(g->Cycle(1500), CycleStatus::kDone);
-  EXPECT_EQ(LimitOf(*g, 2), 560'000);
-  EXPECT_EQ(KindOf(*g, 2), Obstruction::kPrecedingTrain);
+  EXPECT_EQ(LimitAndKindOf(*g, 2), (LimitAndKind{560'000, Obstruction::kPrecedingTrain}));
   // once the leader has left the block (rear 600000 == end, half-open), it is free
   ASSERT_EQ(Report(*g, 1, 700'000), ReportStatus::kAccepted);
   ASSERT_EQ(g->RemoveTrain(2), CommandStatus::kAccepted);
   ASSERT_EQ(Register(*g, 2, 300'000), RegisterStatus::kRegistered);
   ASSERT_EQ(g->Cycle(2000), CycleStatus::kDone);
-  EXPECT_EQ(LimitOf(*g, 2), 580'000);
-  EXPECT_EQ(KindOf(*g, 2), Obstruction::kPrecedingTrain);
+  EXPECT_EQ(LimitAndKindOf(*g, 2), (LimitAndKind{580'000, Obstruction::kPrecedingTrain}));
 }
 
 // @verifies REQ-MB-006
@@ -399,8 +380,8 @@ TEST(WaysideGroundLimit, OwnOccupationOfAFixedBlockIsNoObstruction) {
   // an unequipped occupancy in the second platform: that one obstructs (occupied by another)
   ASSERT_EQ(g->ReportUnequippedOccupancy({790'000, 800'000}).status, CommandStatus::kAccepted);
   ASSERT_EQ(g->Cycle(1000), CycleStatus::kDone);
-  EXPECT_EQ(LimitOf(*g, 1), 679'000);  // 700000 - 21000 < 790000 - 40000
-  EXPECT_EQ(KindOf(*g, 1), Obstruction::kFixedBlock);
+  // 700000 - 21000 < 790000 - 40000
+  EXPECT_EQ(LimitAndKindOf(*g, 1), (LimitAndKind{679'000, Obstruction::kFixedBlock}));
 }
 
 // @verifies REQ-MB-006
@@ -408,15 +389,13 @@ TEST(WaysideGroundLimit, OwnOccupationOfAFixedBlockIsNoObstruction) {
 TEST(WaysideGroundLimit, EntranceOfUnsetAutomaticRoute) {
   TestLine line;
   line.WithJunction();
-  auto g = MakeGround(line);
-  ASSERT_EQ(Register(*g, 1, 500'000), RegisterStatus::kRegistered);
+  auto g = MakeGround(line, {{1, 500'000}});
   ASSERT_EQ(g->RequestRoute(2), CommandStatus::kAccepted);
   ASSERT_EQ(g->Cycle(500), CycleStatus::kDone);
   EXPECT_TRUE(g->RouteSet(2));
   EXPECT_FALSE(g->RouteSet(1));
   EXPECT_TRUE(g->PointsReverse(0));
-  EXPECT_EQ(LimitOf(*g, 1), 970'000);  // 1000000 - 30000
-  EXPECT_EQ(KindOf(*g, 1), Obstruction::kRouteEnd);
+  EXPECT_EQ(LimitAndKindOf(*g, 1), (LimitAndKind{970'000, Obstruction::kRouteEnd}));  // 1000000 - 30000
   // protected 970000 == siding begin - margin: not in use (strict), so it is released
   EXPECT_EQ(g->FreeRoute(2), CommandStatus::kAccepted);
   EXPECT_FALSE(g->RouteSet(2));
@@ -430,12 +409,9 @@ TEST(WaysideGroundLimit, EntranceOfUnsetAutomaticRoute) {
 TEST(WaysideGroundLimit, UnsecuredHandoverPointPerTrain) {
   TestLine line;
   line.handovers = {{7, 800'000}};
-  auto g = MakeGround(line);
-  ASSERT_EQ(Register(*g, 1, 500'000), RegisterStatus::kRegistered);
-  ASSERT_EQ(Register(*g, 2, 300'000), RegisterStatus::kRegistered);
+  auto g = MakeGround(line, {{1, 500'000}, {2, 300'000}});
   ASSERT_EQ(g->Cycle(500), CycleStatus::kDone);
-  EXPECT_EQ(LimitOf(*g, 1), 778'000);  // 800000 - 22000
-  EXPECT_EQ(KindOf(*g, 1), Obstruction::kHandover);
+  EXPECT_EQ(LimitAndKindOf(*g, 1), (LimitAndKind{778'000, Obstruction::kHandover}));  // 800000 - 22000
   EXPECT_EQ(LimitOf(*g, 2), 380'000);
   EXPECT_EQ(g->SecureHandover(1, 7), CommandStatus::kAccepted);
   EXPECT_EQ(g->SecureHandover(9, 7), CommandStatus::kUnknownTrain);
@@ -446,27 +422,24 @@ TEST(WaysideGroundLimit, UnsecuredHandoverPointPerTrain) {
   ASSERT_EQ(Report(*g, 2, 700'000), ReportStatus::kAccepted);
   ASSERT_EQ(g->Cycle(1000), CycleStatus::kDone);
   EXPECT_EQ(LimitOf(*g, 1), kEot);
-  EXPECT_EQ(LimitOf(*g, 2), 778'000);  // not secured for train 2 (780000 from train 1)
-  EXPECT_EQ(KindOf(*g, 2), Obstruction::kHandover);
+  // not secured for train 2 (780000 from train 1)
+  EXPECT_EQ(LimitAndKindOf(*g, 2), (LimitAndKind{778'000, Obstruction::kHandover}));
   // front exactly at the handover point: applies; one millimetre past it: not
   ASSERT_EQ(Report(*g, 2, 800'000), ReportStatus::kAccepted);
   ASSERT_EQ(g->Cycle(1500), CycleStatus::kDone);
   EXPECT_EQ(LimitOf(*g, 2), 778'000);
   ASSERT_EQ(Report(*g, 2, 800'001), ReportStatus::kAccepted);
   ASSERT_EQ(g->Cycle(2000), CycleStatus::kDone);
-  EXPECT_EQ(LimitOf(*g, 2), 780'000);
-  EXPECT_EQ(KindOf(*g, 2), Obstruction::kPrecedingTrain);
+  EXPECT_EQ(LimitAndKindOf(*g, 2), (LimitAndKind{780'000, Obstruction::kPrecedingTrain}));
 }
 
 // @verifies REQ-MB-023
 TEST(WaysideGroundLimit, SystemBoundaryUntilAccepted) {
   TestLine line;
   line.boundary = 1'900'000;
-  auto g = MakeGround(line);
-  ASSERT_EQ(Register(*g, 1, 1'500'000), RegisterStatus::kRegistered);
+  auto g = MakeGround(line, {{1, 1'500'000}});
   ASSERT_EQ(g->Cycle(500), CycleStatus::kDone);
-  EXPECT_EQ(LimitOf(*g, 1), 1'877'000);  // 1900000 - 23000
-  EXPECT_EQ(KindOf(*g, 1), Obstruction::kSystemBoundary);
+  EXPECT_EQ(LimitAndKindOf(*g, 1), (LimitAndKind{1'877'000, Obstruction::kSystemBoundary}));  // 1900000 - 23000
   EXPECT_EQ(g->AcceptAtBoundary(true), CommandStatus::kAccepted);
   ASSERT_EQ(g->Cycle(1000), CycleStatus::kDone);
   EXPECT_EQ(LimitOf(*g, 1), kEot);
@@ -480,14 +453,11 @@ TEST(WaysideGroundLimit, SystemBoundaryUntilAccepted) {
 
 // @verifies REQ-MB-014
 TEST(WaysideGroundLimit, PossessionStartFromTheRequestOn) {
-  TestLine line;
-  auto g = MakeGround(line);
-  ASSERT_EQ(Register(*g, 1, 500'000), RegisterStatus::kRegistered);
+  auto g = MakeGround(TestLine(), {{1, 500'000}});
   const CommandResult p = g->RequestPossession({1'200'000, 1'300'000});
   ASSERT_EQ(p.status, CommandStatus::kAccepted);
   ASSERT_EQ(g->Cycle(500), CycleStatus::kDone);
-  EXPECT_EQ(LimitOf(*g, 1), 1'150'000);  // 1200000 - 50000
-  EXPECT_EQ(KindOf(*g, 1), Obstruction::kPossession);
+  EXPECT_EQ(LimitAndKindOf(*g, 1), (LimitAndKind{1'150'000, Obstruction::kPossession}));  // 1200000 - 50000
   EXPECT_EQ(g->Possession(p.id), PossessionState::kActive);  // nothing in use at the first cycle
   EXPECT_EQ(g->CancelPossession(p.id), CommandStatus::kAccepted);
   EXPECT_EQ(g->CancelPossession(p.id), CommandStatus::kUnknownId);
@@ -498,15 +468,12 @@ TEST(WaysideGroundLimit, PossessionStartFromTheRequestOn) {
 
 // @verifies REQ-MB-016
 TEST(WaysideGroundLimit, UnequippedOccupancyProtectsOtherTrains) {
-  TestLine line;
-  auto g = MakeGround(line);
-  ASSERT_EQ(Register(*g, 1, 500'000), RegisterStatus::kRegistered);
+  auto g = MakeGround(TestLine(), {{1, 500'000}});
   const CommandResult u = g->ReportUnequippedOccupancy({1'200'000, 1'300'000});
   ASSERT_EQ(u.status, CommandStatus::kAccepted);
   EXPECT_EQ(g->ReportUnequippedOccupancy({1'300'000, 1'300'000}).status, CommandStatus::kInvalidRange);
   ASSERT_EQ(g->Cycle(500), CycleStatus::kDone);
-  EXPECT_EQ(LimitOf(*g, 1), 1'160'000);  // 1200000 - 40000
-  EXPECT_EQ(KindOf(*g, 1), Obstruction::kAbnormalTrain);
+  EXPECT_EQ(LimitAndKindOf(*g, 1), (LimitAndKind{1'160'000, Obstruction::kAbnormalTrain}));  // 1200000 - 40000
   EXPECT_FALSE(g->BlockOccupied(23));
   EXPECT_TRUE(g->BlockOccupied(24));
   EXPECT_TRUE(g->BlockOccupied(25));
@@ -525,68 +492,51 @@ TEST(WaysideGroundLimit, TieKeepsTheKindConsideredFirst) {
   {  // PRECEDING_TRAIN (1) vs HANDOVER (5): 898000 - 100000 - 20000 == 800000 - 22000
     TestLine line;
     line.handovers = {{7, 800'000}};
-    auto g = MakeGround(line);
-    ASSERT_EQ(Register(*g, 1, 898'000), RegisterStatus::kRegistered);
-    ASSERT_EQ(Register(*g, 2, 500'000), RegisterStatus::kRegistered);
+    auto g = MakeGround(line, {{1, 898'000}, {2, 500'000}});
     ASSERT_EQ(g->SecureHandover(1, 7), CommandStatus::kAccepted);
     ASSERT_EQ(g->Cycle(500), CycleStatus::kDone);
-    EXPECT_EQ(LimitOf(*g, 2), 778'000);
-    EXPECT_EQ(KindOf(*g, 2), Obstruction::kPrecedingTrain);
+    EXPECT_EQ(LimitAndKindOf(*g, 2), (LimitAndKind{778'000, Obstruction::kPrecedingTrain}));
   }
   {  // END_OF_TRACK (initial) vs POSSESSION (7): 2000000 - 100000 == 1950000 - 50000
     TestLine line;
     line.base.margins.end_of_track_mm = 100'000;
-    auto g = MakeGround(line);
-    ASSERT_EQ(Register(*g, 1, 500'000), RegisterStatus::kRegistered);
+    auto g = MakeGround(line, {{1, 500'000}});
     ASSERT_EQ(g->RequestPossession({1'950'000, 2'000'000}).status, CommandStatus::kAccepted);
     ASSERT_EQ(g->Cycle(500), CycleStatus::kDone);
-    EXPECT_EQ(LimitOf(*g, 1), 1'900'000);
-    EXPECT_EQ(KindOf(*g, 1), Obstruction::kEndOfTrack);
+    EXPECT_EQ(LimitAndKindOf(*g, 1), (LimitAndKind{1'900'000, Obstruction::kEndOfTrack}));
   }
   {  // ROUTE_END (4) vs HANDOVER (5): 1000000 - 30000 == 992000 - 22000
     TestLine line;
     line.WithJunction();
     line.handovers = {{7, 992'000}};
-    auto g = MakeGround(line);
-    ASSERT_EQ(Register(*g, 1, 500'000), RegisterStatus::kRegistered);
+    auto g = MakeGround(line, {{1, 500'000}});
     ASSERT_EQ(g->RequestRoute(2), CommandStatus::kAccepted);
     ASSERT_EQ(g->Cycle(500), CycleStatus::kDone);
-    EXPECT_EQ(LimitOf(*g, 1), 970'000);
-    EXPECT_EQ(KindOf(*g, 1), Obstruction::kRouteEnd);
+    EXPECT_EQ(LimitAndKindOf(*g, 1), (LimitAndKind{970'000, Obstruction::kRouteEnd}));
   }
   {  // POSSESSION (7) vs unequipped ABNORMAL_TRAIN (8): 1200000 - 50000 == 1190000 - 40000
-    TestLine line;
-    auto g = MakeGround(line);
-    ASSERT_EQ(Register(*g, 1, 500'000), RegisterStatus::kRegistered);
+    auto g = MakeGround(TestLine(), {{1, 500'000}});
     ASSERT_EQ(g->ReportUnequippedOccupancy({1'190'000, 1'195'000}).status, CommandStatus::kAccepted);
     ASSERT_EQ(g->RequestPossession({1'200'000, 1'300'000}).status, CommandStatus::kAccepted);
     ASSERT_EQ(g->Cycle(500), CycleStatus::kDone);
-    EXPECT_EQ(LimitOf(*g, 1), 1'150'000);
-    EXPECT_EQ(KindOf(*g, 1), Obstruction::kPossession);
+    EXPECT_EQ(LimitAndKindOf(*g, 1), (LimitAndKind{1'150'000, Obstruction::kPossession}));
   }
   {  // ABNORMAL_TRAIN (2) vs FIXED_BLOCK (3): 1119000 - 100000 - 40000 == 1000000 - 21000
     TestLine line;
     line.fixed = {{1'000'000, 1'100'000}};
-    auto g = MakeGround(line);
-    ASSERT_EQ(Register(*g, 1, 1'119'000), RegisterStatus::kRegistered);
-    ASSERT_EQ(Register(*g, 2, 500'000), RegisterStatus::kRegistered);
+    auto g = MakeGround(line, {{1, 1'119'000}, {2, 500'000}});
     ASSERT_EQ(g->Cycle(500), CycleStatus::kDone);
     ASSERT_EQ(Report(*g, 2, 500'000), ReportStatus::kAccepted);
     ASSERT_EQ(g->Cycle(3001), CycleStatus::kDone);
     ASSERT_TRUE(AbnormalOf(*g, 1));
-    EXPECT_EQ(LimitOf(*g, 2), 979'000);
-    EXPECT_EQ(KindOf(*g, 2), Obstruction::kAbnormalTrain);
+    EXPECT_EQ(LimitAndKindOf(*g, 2), (LimitAndKind{979'000, Obstruction::kAbnormalTrain}));
   }
 }
 
 // @verifies REQ-MB-006
 // @verifies REQ-MB-008
 TEST(WaysideGroundLimit, OnlyTrainsWithAFrontStrictlyAheadObstruct) {
-  TestLine line;
-  auto g = MakeGround(line);
-  ASSERT_EQ(Register(*g, 1, 300'000), RegisterStatus::kRegistered);
-  ASSERT_EQ(Register(*g, 2, 500'000), RegisterStatus::kRegistered);
-  ASSERT_EQ(Register(*g, 3, 700'001), RegisterStatus::kRegistered);
+  auto g = MakeGround(TestLine(), {{1, 300'000}, {2, 500'000}, {3, 700'001}});
   ASSERT_EQ(Report(*g, 1, 500'000), ReportStatus::kAccepted);  // equal fronts (ranges overlap)
   ASSERT_EQ(g->Cycle(500), CycleStatus::kDone);
   EXPECT_EQ(LimitOf(*g, 1), 580'001);  // train 3 only: 700001 - 100000 - 20000
@@ -611,23 +561,18 @@ TEST(WaysideGroundLimit, NoStopSectionPullsTheLimitBackWithTheKindsMargin) {
   for (const Case& c : cases) {
     TestLine line;
     line.no_stop = {{1'400'000, 1'460'000}, {1'500'000, 1'550'000}};
-    auto g = MakeGround(line);
-    ASSERT_EQ(Register(*g, 1, 500'000), RegisterStatus::kRegistered);
+    auto g = MakeGround(line, {{1, 500'000}});
     ASSERT_EQ(g->RequestPossession({c.possession_begin, c.possession_begin + 10'000}).status,
               CommandStatus::kAccepted);
     ASSERT_EQ(g->Cycle(500), CycleStatus::kDone);
-    EXPECT_EQ(LimitOf(*g, 1), c.expected) << c.possession_begin;
-    EXPECT_EQ(KindOf(*g, 1), Obstruction::kPossession);
+    EXPECT_EQ(LimitAndKindOf(*g, 1), (LimitAndKind{c.expected, Obstruction::kPossession})) << c.possession_begin;
   }
 }
 
 // @verifies REQ-MB-024
 // @verifies REQ-MB-015
 TEST(WaysideGroundLimit, TelegramToEveryTrackedTrainEveryCycle) {
-  TestLine line;
-  auto g = MakeGround(line);
-  ASSERT_EQ(Register(*g, 5, 1'000'000), RegisterStatus::kRegistered);
-  ASSERT_EQ(Register(*g, 3, 500'000), RegisterStatus::kRegistered);
+  auto g = MakeGround(TestLine(), {{5, 1'000'000}, {3, 500'000}});
   for (std::int64_t now = 500; now <= 1500; now += 500) {
     ASSERT_EQ(g->Cycle(now), CycleStatus::kDone);
     ASSERT_EQ(Report(*g, 5, 1'000'000), ReportStatus::kAccepted);
@@ -650,8 +595,7 @@ TEST(WaysideGroundLimit, TelegramToEveryTrackedTrainEveryCycle) {
 
 // @verifies REQ-MB-004
 TEST(WaysideGroundTracking, TimeoutIsStrict) {
-  TestLine line;
-  auto g = MakeGround(line);
+  auto g = MakeGround(TestLine());
   ASSERT_EQ(Register(*g, 1, 500'000), RegisterStatus::kRegistered);  // stamped 0
   ASSERT_EQ(g->Cycle(3000), CycleStatus::kDone);
   EXPECT_FALSE(AbnormalOf(*g, 1));  // exactly the timeout: still tracked
@@ -665,9 +609,7 @@ TEST(WaysideGroundTracking, TimeoutIsStrict) {
 // @verifies REQ-MB-009
 // @verifies REQ-MB-014
 TEST(WaysideGroundTracking, FrozenBoundIsTheLargestLimitStillValid) {
-  TestLine line;
-  auto g = MakeGround(line);
-  ASSERT_EQ(Register(*g, 1, 1'000'000), RegisterStatus::kRegistered);
+  auto g = MakeGround(TestLine(), {{1, 1'000'000}});
   ASSERT_EQ(g->Cycle(500), CycleStatus::kDone);
   EXPECT_EQ(LimitOf(*g, 1), kEot);
   const CommandResult p = g->RequestPossession({1'200'000, 1'300'000});
@@ -680,8 +622,8 @@ TEST(WaysideGroundTracking, FrozenBoundIsTheLargestLimitStillValid) {
   EXPECT_EQ(g->ProtectedAuthority(1), kEot);
   ASSERT_EQ(g->Cycle(3001), CycleStatus::kDone);
   ASSERT_TRUE(AbnormalOf(*g, 1));
-  EXPECT_EQ(LimitOf(*g, 1), kEot);  // frozen = protected = 1990000 (issued at 500, age 2501)
-  EXPECT_EQ(KindOf(*g, 1), Obstruction::kNone);
+  // frozen = protected = 1990000 (issued at 500, age 2501)
+  EXPECT_EQ(LimitAndKindOf(*g, 1), (LimitAndKind{kEot, Obstruction::kNone}));
   const auto ext = g->Extended(1);
   ASSERT_TRUE(ext.has_value());
   EXPECT_EQ(ext->begin_mm, 900'000);
@@ -696,9 +638,7 @@ TEST(WaysideGroundTracking, FrozenBoundIsTheLargestLimitStillValid) {
 // @verifies REQ-MB-009
 // @verifies REQ-MB-014
 TEST(WaysideGroundTracking, IssuedLimitsExpireStrictlyAfterTheValidity) {
-  TestLine line;
-  auto g = MakeGround(line);
-  ASSERT_EQ(Register(*g, 1, 500'000), RegisterStatus::kRegistered);
+  auto g = MakeGround(TestLine(), {{1, 500'000}});
   ASSERT_EQ(g->Cycle(500), CycleStatus::kDone);  // issues 1990000 at 500
   const CommandResult p = g->RequestPossession({1'200'000, 1'300'000});
   for (std::int64_t now = 1000; now <= 3500; now += 500) {
@@ -719,8 +659,7 @@ TEST(WaysideGroundTracking, IssuedLimitsExpireStrictlyAfterTheValidity) {
 // @verifies REQ-MB-010
 // @verifies REQ-MB-003
 TEST(WaysideGroundOccupancy, BlocksOverlappedByTheExtendedRange) {
-  TestLine line;
-  auto g = MakeGround(line);
+  auto g = MakeGround(TestLine());
   // [240000 - 100000 - 20000, 240000 + 20000) = [120000, 260000): blocks 2..5
   ASSERT_EQ(Register(*g, 1, 240'000, 20'000), RegisterStatus::kRegistered);
   // [110000, 250000) would end exactly on block 5's begin
@@ -750,9 +689,7 @@ TEST(WaysideGroundOccupancy, BlocksOverlappedByTheExtendedRange) {
 TEST(WaysideGroundD2, BuffersRoundedUp) {
   TestLine line;
   line.base.policy = MarginPolicy::kD2Buffers;  // r = 1000 ppm, tau = 500 ms, l_c = 2000 mm
-  auto g = MakeGround(line);
-  ASSERT_EQ(Register(*g, 1, 1'300'000), RegisterStatus::kRegistered);
-  ASSERT_EQ(Register(*g, 2, 500'000), RegisterStatus::kRegistered);
+  auto g = MakeGround(line, {{1, 1'300'000}, {2, 500'000}});
   // x - x_m = 1234567 mm: r(x - x_m) = 1234.567 -> 1235; v tau = 22223 * 0.5 = 11111.5 -> 11112
   PositionReport r = MakeReport(*g, 1, 1'334'567);
   r.last_balise_mm = 100'000;
@@ -791,9 +728,7 @@ TEST(WaysideGroundD2, BuffersRoundedUp) {
 // @verifies REQ-MB-002
 // @verifies REQ-MB-003
 TEST(WaysideGroundD2, ReportedCorrectionPolicyUsesTheReportedCorrection) {
-  TestLine line;
-  auto g = MakeGround(line);
-  ASSERT_EQ(Register(*g, 1, 1'300'000), RegisterStatus::kRegistered);
+  auto g = MakeGround(TestLine(), {{1, 1'300'000}});
   PositionReport r = MakeReport(*g, 1, 1'334'567, 1'234);
   r.last_balise_mm = 100'000;
   r.speed_mm_s = 22'223;
@@ -814,8 +749,7 @@ TEST(WaysideGroundD2, ReportedCorrectionPolicyUsesTheReportedCorrection) {
 TEST(WaysideGroundInterlocking, ConflictingRequestWaitsWhileTheRouteIsInUse) {
   TestLine line;
   line.WithJunction();
-  auto g = MakeGround(line);
-  ASSERT_EQ(Register(*g, 1, 500'000), RegisterStatus::kRegistered);
+  auto g = MakeGround(line, {{1, 500'000}});
   ASSERT_EQ(g->Cycle(500), CycleStatus::kDone);
   EXPECT_TRUE(g->RouteSet(1));  // automatic, nothing in use
   EXPECT_FALSE(g->PointsReverse(0));
@@ -844,8 +778,7 @@ TEST(WaysideGroundInterlocking, ApproachLockingEdgeIsStrict) {
   for (const std::int64_t begin : {std::int64_t{1'020'000}, std::int64_t{1'020'001}}) {
     TestLine line;
     line.WithJunction();
-    auto g = MakeGround(line);
-    ASSERT_EQ(Register(*g, 1, 500'000), RegisterStatus::kRegistered);
+    auto g = MakeGround(line, {{1, 500'000}});
     ASSERT_EQ(g->RequestPossession({begin, begin + 10'000}).status, CommandStatus::kAccepted);
     ASSERT_EQ(g->Cycle(500), CycleStatus::kDone);
     ASSERT_TRUE(g->RouteSet(1));
@@ -894,8 +827,7 @@ TEST(WaysideGroundInterlocking, UnequippedOccupancyLocksThePoints) {
 
 // @verifies REQ-MB-014
 TEST(WaysideGroundPossession, ActiveOnlyOnceFreeOfTrainsAndAuthority) {
-  TestLine line;
-  auto g = MakeGround(line);
+  auto g = MakeGround(TestLine());
   ASSERT_EQ(Register(*g, 1, 1'250'000), RegisterStatus::kRegistered);  // inside the area
   ASSERT_EQ(Register(*g, 2, 500'000), RegisterStatus::kRegistered);
   const CommandResult p = g->RequestPossession({1'200'000, 1'300'000});
@@ -903,15 +835,14 @@ TEST(WaysideGroundPossession, ActiveOnlyOnceFreeOfTrainsAndAuthority) {
   EXPECT_EQ(g->Possession(p.id), PossessionState::kRequested);
   ASSERT_EQ(g->Cycle(500), CycleStatus::kDone);
   EXPECT_EQ(g->Possession(p.id), PossessionState::kRequested);  // occupied: held
-  EXPECT_EQ(LimitOf(*g, 2), 1'130'000);  // train 1's rear 1150000 - 20000 < 1200000 - 50000
-  EXPECT_EQ(KindOf(*g, 2), Obstruction::kPrecedingTrain);
+  // train 1's rear 1150000 - 20000 < 1200000 - 50000
+  EXPECT_EQ(LimitAndKindOf(*g, 2), (LimitAndKind{1'130'000, Obstruction::kPrecedingTrain}));
   // train 1 leaves the area (rear 1300000 == end: half-open, free); train 2's authority
   // (1130000) ends before 1200000 - 50000: the possession is confirmed
   ASSERT_EQ(Report(*g, 1, 1'400'000), ReportStatus::kAccepted);
   ASSERT_EQ(g->Cycle(1000), CycleStatus::kDone);
   EXPECT_EQ(g->Possession(p.id), PossessionState::kActive);
-  EXPECT_EQ(LimitOf(*g, 2), 1'150'000);
-  EXPECT_EQ(KindOf(*g, 2), Obstruction::kPossession);
+  EXPECT_EQ(LimitAndKindOf(*g, 2), (LimitAndKind{1'150'000, Obstruction::kPossession}));
   // active stays active; cancel removes the obstruction
   ASSERT_EQ(g->Cycle(1500), CycleStatus::kDone);
   EXPECT_EQ(g->Possession(p.id), PossessionState::kActive);
@@ -925,8 +856,7 @@ TEST(WaysideGroundPossession, ActiveOnlyOnceFreeOfTrainsAndAuthority) {
 
 // @verifies REQ-MB-014
 TEST(WaysideGroundPossession, RejectsInvalidRanges) {
-  TestLine line;
-  auto g = MakeGround(line);
+  auto g = MakeGround(TestLine());
   EXPECT_EQ(g->RequestPossession({100, 100}).status, CommandStatus::kInvalidRange);
   EXPECT_EQ(g->RequestPossession({-1, 100}).status, CommandStatus::kInvalidRange);
   EXPECT_EQ(g->RequestPossession({100, kLen + 1}).status, CommandStatus::kInvalidRange);
@@ -942,9 +872,7 @@ TEST(WaysideGroundPossession, RejectsInvalidRanges) {
 // @verifies REQ-MB-015
 // @verifies REQ-MB-024
 TEST(WaysideGroundRestriction, SentOnlyOnceConfirmedAndEveryCycleUntilTheRearHasLeft) {
-  TestLine line;
-  auto g = MakeGround(line);
-  ASSERT_EQ(Register(*g, 1, 500'000), RegisterStatus::kRegistered);
+  auto g = MakeGround(TestLine(), {{1, 500'000}});
   const CommandResult r = g->RequestSpeedRestriction({600'000, 700'000}, 8'333);
   ASSERT_EQ(r.status, CommandStatus::kAccepted);
   EXPECT_EQ(g->RequestSpeedRestriction({600'000, 700'000}, 0).status, CommandStatus::kInvalidRange);
@@ -981,9 +909,7 @@ TEST(WaysideGroundRestriction, SentOnlyOnceConfirmedAndEveryCycleUntilTheRearHas
 // @verifies REQ-MB-015
 // @verifies REQ-MB-024
 TEST(WaysideGroundRestriction, NearestFirstAndTruncatedAtTheTelegramMaximum) {
-  TestLine line;
-  auto g = MakeGround(line);
-  ASSERT_EQ(Register(*g, 1, 100'000), RegisterStatus::kRegistered);
+  auto g = MakeGround(TestLine(), {{1, 100'000}});
   std::vector<std::uint32_t> ids;
   for (std::int64_t k = 10; k > 0; --k) {  // entered furthest first
     const CommandResult r = g->RequestSpeedRestriction({k * 100'000, k * 100'000 + 50'000}, 10'000 + k);
@@ -1003,8 +929,7 @@ TEST(WaysideGroundRestriction, NearestFirstAndTruncatedAtTheTelegramMaximum) {
 
 // @verifies REQ-MB-016
 TEST(WaysideGroundInitial, ProvisionalAndEntryBalisePositionsProtect) {
-  TestLine line;
-  auto g = MakeGround(line);
+  auto g = MakeGround(TestLine());
   ASSERT_EQ(Register(*g, 1, 1'000'000, 5'000, InitialPosition::kStabledProvisional), RegisterStatus::kRegistered);
   ASSERT_EQ(Register(*g, 2, 200'000, 0, InitialPosition::kEntryBalise), RegisterStatus::kRegistered);
   ASSERT_EQ(g->Cycle(500), CycleStatus::kDone);
@@ -1021,8 +946,7 @@ TEST(WaysideGroundInitial, ProvisionalAndEntryBalisePositionsProtect) {
 // @verifies REQ-MB-021
 TEST(WaysideGroundInitial, RegistrationRejectsWithTypedReason) {
   TestLine line;
-  auto g = MakeGround(line);
-  ASSERT_EQ(Register(*g, 1, 200'000), RegisterStatus::kRegistered);
+  auto g = MakeGround(line, {{1, 200'000}});
   EXPECT_EQ(Register(*g, 1, 400'000), RegisterStatus::kDuplicateId);
   EXPECT_EQ(Register(*g, 2, 400'000, 0, InitialPosition::kEntryBalise, 0), RegisterStatus::kLengthInvalid);
   EXPECT_EQ(Register(*g, 2, kLen + 1), RegisterStatus::kFrontOffLine);
@@ -1161,9 +1085,7 @@ TEST(WaysideGroundRuntime, DeterministicOutputs) {
 
 // @verifies REQ-MB-021
 TEST(WaysideGroundRuntime, ClockGoingBackIsRefused) {
-  TestLine line;
-  auto g = MakeGround(line);
-  ASSERT_EQ(Register(*g, 1, 500'000), RegisterStatus::kRegistered);
+  auto g = MakeGround(TestLine(), {{1, 500'000}});
   ASSERT_EQ(g->Cycle(1000), CycleStatus::kDone);
   EXPECT_EQ(g->Telegrams().size(), 1U);
   EXPECT_EQ(g->Cycle(999), CycleStatus::kClockWentBack);

@@ -85,6 +85,38 @@ std::unique_ptr<Odometry> Make() {
   return od;
 }
 
+// A fresh odometry stepped through the stream up to its first detection cycle: the cycle and
+// the state after it (with `before`: the state before it).
+struct Detection {
+  std::size_t cycle = 0;
+  std::unique_ptr<Odometry> state;  // null: no detection (the benchmark is skipped)
+};
+
+Detection RunToDetection(benchmark::State& state, const std::vector<CycleInput>& stream, bool before) {
+  auto od = Make();
+  for (std::size_t k = 0; k < stream.size(); ++k) {
+    const Odometry previous(*od);
+    if (od->Step(stream[k]).detected) {
+      if (before) {
+        *od = previous;
+      }
+      return {k, std::move(od)};
+    }
+  }
+  state.SkipWithError("no detection");
+  return {};
+}
+
+// One Step timed by hand (the benchmarks below use manual time); its output.
+const OdometryOutput& TimedStep(benchmark::State& state, Odometry& od, const CycleInput& in) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const OdometryOutput& o = od.Step(in);
+  benchmark::DoNotOptimize(o);
+  const auto t1 = std::chrono::steady_clock::now();
+  state.SetIterationTime(std::chrono::duration<double>(t1 - t0).count());
+  return o;
+}
+
 // TG odometry: every cycle of a 4096-cycle stream without slip (re-created at its end).
 void BM_OdometryStepTg(benchmark::State& state) {
   const auto stream = MakeStream(4'096, 1'000'000, false);
@@ -109,30 +141,20 @@ BENCHMARK(BM_OdometryStepTg);
 // older candidate times out, replayed from a copy of the state after the detection.
 void BM_OdometryStepCompensatingTwoCandidates(benchmark::State& state) {
   const auto stream = MakeStream(400, 200, false);
-  auto od = Make();
-  std::size_t d = 0;
-  for (std::size_t k = 0; k < stream.size(); ++k) {
-    if (od->Step(stream[k]).detected) {
-      d = k;
-      break;
-    }
-  }
-  if (d == 0) {
-    state.SkipWithError("no detection");
+  const Detection at = RunToDetection(state, stream, false);
+  if (!at.state) {
     return;
   }
-  auto snapshot = std::make_unique<Odometry>(*od);
+  const std::size_t d = at.cycle;
+  auto od = std::make_unique<Odometry>(*at.state);
   std::size_t i = d + 1;
   for (auto _ : state) {
     const auto& st = od->machine().state();
     if (i == stream.size() || !(st.candidates[0].active && st.candidates[1].active)) {
-      *od = *snapshot;
+      *od = *at.state;
       i = d + 1;
     }
-    const auto t0 = std::chrono::steady_clock::now();
-    benchmark::DoNotOptimize(od->Step(stream[i]));
-    const auto t1 = std::chrono::steady_clock::now();
-    state.SetIterationTime(std::chrono::duration<double>(t1 - t0).count());
+    TimedStep(state, *od, stream[i]);
     ++i;
   }
   state.SetLabel("two candidates active");
@@ -142,30 +164,15 @@ BENCHMARK(BM_OdometryStepCompensatingTwoCandidates)->UseManualTime();
 // The detection cycle with the deepest catch-up (start point d - 75, second d - 100).
 void BM_OdometryStepDetectionWorstCase(benchmark::State& state) {
   const auto stream = MakeStream(300, 200, true);
-  auto od = Make();
-  std::size_t d = 0;
-  for (std::size_t k = 0; k < stream.size(); ++k) {
-    Odometry before(*od);
-    if (od->Step(stream[k]).detected) {
-      d = k;
-      *od = before;
-      break;
-    }
-  }
-  if (d == 0) {
-    state.SkipWithError("no detection");
+  const Detection at = RunToDetection(state, stream, true);
+  if (!at.state) {
     return;
   }
-  auto snapshot = std::make_unique<Odometry>(*od);
+  auto od = std::make_unique<Odometry>(*at.state);
   std::int32_t age = 0;
   for (auto _ : state) {
-    *od = *snapshot;
-    const auto t0 = std::chrono::steady_clock::now();
-    const auto& o = od->Step(stream[d]);
-    benchmark::DoNotOptimize(o);
-    const auto t1 = std::chrono::steady_clock::now();
-    state.SetIterationTime(std::chrono::duration<double>(t1 - t0).count());
-    age = o.start_age_cycles;
+    *od = *at.state;
+    age = TimedStep(state, *od, stream[at.cycle]).start_age_cycles;
   }
   if (age != 75) state.SkipWithError("not the deepest catch-up");
   state.SetLabel("catch-up 75 + 100 cycles");

@@ -18,48 +18,24 @@
 // mismatch the failure names the vector, the step, the field, expected and actual.
 // Last line: "railproof-conformance-ra: all N vectors passed" or
 // "railproof-conformance-ra: vectors mismatched: K of N" or "...: error: <reason>".
-#include <gtest/gtest.h>
-
-#include <atomic>
 #include <cstddef>
 #include <cstdint>
-#include <cstdio>
-#include <filesystem>
 #include <map>
 #include <nlohmann/json.hpp>
-#include <set>
 #include <string>
 #include <vector>
 
-#include "railproof/testing/jsonl_vectors.hpp"
 #include "railproof/ra/readhesion_machine.hpp"
-#include "railproof/testing/runner_cli.hpp"
+#include "railproof/testing/jsonl_runner.hpp"
 
 namespace rcli = railproof::conformance;
 
 namespace {
 
-namespace fs = std::filesystem;
 namespace ro = railproof::ra;
 using json = nlohmann::json;
 
-constexpr const char* kModel = "models/ra.pml";
-constexpr const char* kUnits = "model ticks = cycles, model margin units = mm";
-
-struct Vector {
-  std::string id;
-  std::string test_name;
-  std::string file;
-  std::size_t line = 0;
-  ro::MachineConfig config;
-  json steps;
-};
-
-std::vector<Vector> g_vectors;
-std::set<std::string> g_files;
 std::map<std::string, ro::MachineConfig> g_configs;  // per file, from its header
-std::atomic<std::size_t> g_mismatched{0};
-std::atomic<std::size_t> g_replayed{0};
 
 bool IsBool(const json& o, const char* k) { return o.contains(k) && o[k].is_boolean(); }
 bool IsInt(const json& o, const char* k) { return o.contains(k) && o[k].is_number_integer(); }
@@ -68,9 +44,7 @@ bool BoolPair(const json& o, const char* k) {
   return o.contains(k) && o[k].is_array() && o[k].size() == 2 && o[k][0].is_boolean() && o[k][1].is_boolean();
 }
 
-// Checks the shape of one step (the schema is checked when the vectors are written; this
-// guards the harness against a hand-edited or truncated file).
-bool StepWellFormed(const json& step) {
+bool StepWellFormed(const std::string& /*file*/, const json& step) {
   if (!step.is_object() || !step.contains("in") || !step.contains("out") || !step["in"].is_object() ||
       !step["out"].is_object()) {
     return false;
@@ -137,122 +111,76 @@ std::string ConfigFromHeader(const json& obj, ro::MachineConfig& cfg) {
   return "";
 }
 
-// Loads every ra*.jsonl of dir; an error names the file and line.
-bool Load(const fs::path& dir, std::string& error) {
-  std::size_t files = 0;
-  error = rcli::ReadVectorDirectory(
-      dir, "ra",
-      [](const std::string& file, const json& obj) -> std::string {
-        if (obj.value("kind", "") != "header" || obj.value("model", "") != kModel || !obj.contains("parameters")) {
-          return "first line is not a " + std::string(kModel) + " vector header";
-        }
-        if (obj.value("units", "") != kUnits) {
-          return "header units must be \"" + std::string(kUnits) + "\"";
-        }
-        ro::MachineConfig cfg;
-        if (std::string e = ConfigFromHeader(obj, cfg); !e.empty()) {
-          return e;
-        }
-        g_configs[file] = cfg;
-        g_files.insert(file);
-        return "";
-      },
-      [](const rcli::VectorLine& line) -> std::string {
-        for (const json& step : (*line.obj)["steps"]) {
-          if (!StepWellFormed(step)) {
-            return "malformed step in vector " + line.id;
-          }
-        }
-        g_vectors.push_back(
-            Vector{line.id, line.test_name, line.file, line.line, g_configs.at(line.file), (*line.obj)["steps"]});
-        return "";
-      },
-      files);
-  return error.empty();
+// A file's header: the machine configuration of its vectors.
+std::string Header(const std::string& file, const json& obj) {
+  ro::MachineConfig cfg;
+  if (std::string e = ConfigFromHeader(obj, cfg); !e.empty()) {
+    return e;
+  }
+  g_configs[file] = cfg;
+  return "";
 }
 
-std::string Bool(bool b) { return b ? "true" : "false"; }
+using rcli::Bool;
 std::string Adopted(std::int8_t a) { return a == ro::kNoCandidate ? "null" : std::to_string(a); }
-std::string Adopted(const json& a) { return a.is_null() ? "null" : std::to_string(a.get<std::int64_t>()); }
 
-class VectorTest : public testing::Test {
- public:
-  explicit VectorTest(std::size_t index) : index_(index) {}
-  void TestBody() override {
-    const Vector& v = g_vectors[index_];
-    g_replayed.fetch_add(1);
-    RecordProperty("vector_id", v.id);
-    std::vector<std::string> problems;
-    Replay(v, problems);
-    if (!problems.empty()) {
-      g_mismatched.fetch_add(1);
+void Replay(const rcli::JsonVector& v, std::vector<std::string>& problems) {
+  ro::ReadhesionMachine m(g_configs.at(v.file));
+  for (std::size_t k = 0; k < v.steps.size() && problems.empty(); ++k) {
+    const json& in = v.steps[k].at("in");
+    const json& out = v.steps[k].at("out");
+    ro::Predicates p;
+    p.deviation = in.at("deviation").get<bool>();
+    p.speed_agrees[0] = in.at("speed_agrees")[0].get<bool>();
+    p.speed_agrees[1] = in.at("speed_agrees")[1].get<bool>();
+    p.imu_ok = in.at("imu_ok").get<bool>();
+    p.tg_ok = in.at("tg_ok").get<bool>();
+    p.balise = in.at("balise").get<bool>();
+    p.section.max_compensation_cycles = in.at("section").at("max_compensation_cycles").get<std::int32_t>();
+    p.section.margin_mm = in.at("section").at("margin_mm").get<std::int64_t>();
+    p.start_age_cycles = in.at("start_age_cycles").get<std::int32_t>();
+    rcli::Checker chk(problems, "step " + std::to_string(k) + " (cycle " + std::to_string(k + 1) + "): ", &in);
+    if (const ro::MachineError e = m.Step(p); e != ro::MachineError::kNone) {
+      chk.Fail(std::string("Step rejected the inputs: ") + ro::ToString(e));
+      break;
     }
-    for (const std::string& p : problems) {
-      ADD_FAILURE_AT(v.file.c_str(), static_cast<int>(v.line)) << "vector " << v.id << ": " << p;
+    const ro::MachineState& s = m.state();
+    auto num = [](const json& j) { return std::to_string(j.get<std::int64_t>()); };
+    chk.Expect("mode", out.at("mode").get<std::string>(), ro::ToString(s.mode));
+    chk.Expect("stop_reason", out.at("stop_reason").get<std::string>(), ro::ToString(s.stop_reason));
+    chk.Expect("deviation_count", num(out.at("deviation_count")), std::to_string(s.deviation_count));
+    for (std::size_t c = 0; c < static_cast<std::size_t>(ro::kMaxStartPoints); ++c) {
+      const json& ec = out.at("candidates")[c];
+      const ro::Candidate& ac = s.candidates[c];
+      const std::string name = "candidates[" + std::to_string(c) + "].";
+      chk.Expect(name + "active", Bool(ec.at("active").get<bool>()), Bool(ac.active));
+      chk.Expect(name + "age_cycles", num(ec.at("age_cycles")), std::to_string(ac.age_cycles));
+      chk.Expect(name + "confirm", num(ec.at("confirm")), std::to_string(ac.confirm));
     }
+    chk.Expect("max_compensation_cycles", num(out.at("max_compensation_cycles")),
+               std::to_string(s.max_compensation_cycles));
+    chk.Expect("margin_mm", num(out.at("margin_mm")), std::to_string(s.margin_mm));
+    chk.Expect("stop_demand", Bool(out.at("stop_demand").get<bool>()), Bool(s.stop_demand));
+    chk.Expect("position_valid", Bool(out.at("position_valid").get<bool>()), Bool(s.position_valid));
+    chk.Expect("detected", Bool(out.at("detected").get<bool>()), Bool(s.detected));
+    chk.Expect("adopted", rcli::OptInt(out.at("adopted")), Adopted(s.adopted));
+    chk.Expect("balise_reset", Bool(out.at("balise_reset").get<bool>()), Bool(s.balise_reset));
   }
-
- private:
-  static void Replay(const Vector& v, std::vector<std::string>& problems) {
-    ro::ReadhesionMachine m(v.config);
-    for (std::size_t k = 0; k < v.steps.size() && problems.empty(); ++k) {
-      const json& in = v.steps[k].at("in");
-      const json& out = v.steps[k].at("out");
-      ro::Predicates p;
-      p.deviation = in.at("deviation").get<bool>();
-      p.speed_agrees[0] = in.at("speed_agrees")[0].get<bool>();
-      p.speed_agrees[1] = in.at("speed_agrees")[1].get<bool>();
-      p.imu_ok = in.at("imu_ok").get<bool>();
-      p.tg_ok = in.at("tg_ok").get<bool>();
-      p.balise = in.at("balise").get<bool>();
-      p.section.max_compensation_cycles = in.at("section").at("max_compensation_cycles").get<std::int32_t>();
-      p.section.margin_mm = in.at("section").at("margin_mm").get<std::int64_t>();
-      p.start_age_cycles = in.at("start_age_cycles").get<std::int32_t>();
-      const std::string where = "step " + std::to_string(k) + " (cycle " + std::to_string(k + 1) + "): ";
-      if (const ro::MachineError e = m.Step(p); e != ro::MachineError::kNone) {
-        problems.push_back(where + "Step rejected the inputs: " + ro::ToString(e) + " [inputs " + in.dump() + "]");
-        break;
-      }
-      const ro::MachineState& s = m.state();
-      auto expect = [&](const std::string& field, const std::string& expected, const std::string& actual) {
-        if (expected != actual) {
-          problems.push_back(where + field + " expected " + expected + ", got " + actual + " [inputs " + in.dump() +
-                             "]");
-        }
-      };
-      auto num = [](const json& j) { return std::to_string(j.get<std::int64_t>()); };
-      expect("mode", out.at("mode").get<std::string>(), ro::ToString(s.mode));
-      expect("stop_reason", out.at("stop_reason").get<std::string>(), ro::ToString(s.stop_reason));
-      expect("deviation_count", num(out.at("deviation_count")), std::to_string(s.deviation_count));
-      for (std::size_t c = 0; c < static_cast<std::size_t>(ro::kMaxStartPoints); ++c) {
-        const json& ec = out.at("candidates")[c];
-        const ro::Candidate& ac = s.candidates[c];
-        const std::string name = "candidates[" + std::to_string(c) + "].";
-        expect(name + "active", Bool(ec.at("active").get<bool>()), Bool(ac.active));
-        expect(name + "age_cycles", num(ec.at("age_cycles")), std::to_string(ac.age_cycles));
-        expect(name + "confirm", num(ec.at("confirm")), std::to_string(ac.confirm));
-      }
-      expect("max_compensation_cycles", num(out.at("max_compensation_cycles")),
-             std::to_string(s.max_compensation_cycles));
-      expect("margin_mm", num(out.at("margin_mm")), std::to_string(s.margin_mm));
-      expect("stop_demand", Bool(out.at("stop_demand").get<bool>()), Bool(s.stop_demand));
-      expect("position_valid", Bool(out.at("position_valid").get<bool>()), Bool(s.position_valid));
-      expect("detected", Bool(out.at("detected").get<bool>()), Bool(s.detected));
-      expect("adopted", Adopted(out.at("adopted")), Adopted(s.adopted));
-      expect("balise_reset", Bool(out.at("balise_reset").get<bool>()), Bool(s.balise_reset));
-    }
-  }
-
-  std::size_t index_;
-};
+}
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  return rcli::RunnerMain<VectorTest>(
-      "railproof-conformance-ra", "ReadhesionConformance",
-      "Replays every ra*.jsonl vector of DIR against the C++ re-adhesion state machine\n"
-      "(ra::ReadhesionMachine), configured by each file's header. Exit 0 only if every\n"
-      "vector matches.",
-      argc, argv, Load, g_vectors, g_files, g_mismatched, g_replayed);
+  return rcli::RunJsonVectors({.prog = "railproof-conformance-ra",
+                               .suite = "ReadhesionConformance",
+                               .description = "Replays every ra*.jsonl vector of DIR against the C++ re-adhesion state "
+                                              "machine\n(ra::ReadhesionMachine), configured by each file's header. "
+                                              "Exit 0 only if every\nvector matches.",
+                               .prefix = "ra",
+                               .models = {"models/ra.pml"},
+                               .units = "model ticks = cycles, model margin units = mm",
+                               .header = Header,
+                               .step_ok = StepWellFormed,
+                               .replay = Replay},
+                              argc, argv);
 }

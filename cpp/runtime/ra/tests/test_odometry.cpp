@@ -371,12 +371,8 @@ TEST(OdometryCompensation, LevelConstantAccelerationExact) {
 // @verifies REQ-RA-005
 TEST(OdometryCompensation, ConstantGradientPitchExact) {
   const double theta = std::atan(0.02);
-  const SlipRun r = RunSlip(Config(LevelLine()), 12.0, 0.0, 80, 10, 3.0, 140, [theta](int, double) {
-    ImuValues m;
-    m.ax = kG * std::sin(theta);
-    m.az = kG * std::cos(theta);
-    return m;
-  });
+  const SlipRun r = RunSlip(Config(LevelLine()), 12.0, 0.0, 80, 10, 3.0, 140,
+                            [theta](int, double) { return OnGradient(theta); });
   ExpectExactConstantCompensation(r, kG * std::sin(theta));
   const int d = r.detection;
   const int s = d - Get(r.out, d).start_age_cycles;
@@ -467,12 +463,8 @@ TEST(OdometryCompensation, CantedCurveCorrectionMatters) {
 // @verifies REQ-RA-006
 TEST(OdometryReadhesion, CompensatedDistanceReplacesTheTgOverCount) {
   const double theta = std::atan(0.02);
-  const SlipRun r = RunSlip(Config(LevelLine()), 12.0, 0.0, 80, 10, 3.0, 200, [theta](int, double) {
-    ImuValues m;
-    m.ax = kG * std::sin(theta);
-    m.az = kG * std::cos(theta);
-    return m;
-  });
+  const SlipRun r = RunSlip(Config(LevelLine()), 12.0, 0.0, 80, 10, 3.0, 200,
+                            [theta](int, double) { return OnGradient(theta); });
   ASSERT_GE(r.detection, 0);
   int adopted_at = -1;
   for (int k = r.detection + 1; k < 200; ++k) {
@@ -833,34 +825,32 @@ TEST(OdometrySections, LimitsUnderTheTrainWithThePreviousMargin) {
                                             {1'000'000, 1'200'000, 350, 20'000, 0},
                                             {1'200'000, 5'000'000, 0, 10'000, 0}};
   OdometryConfig cfg = Config(sec);
-  cfg.initial_front_mm = 900'000;
-  auto od = Make(cfg);
-  Stream s(0.0);
-  // at rest at 900 m: [840 - 8.9, 900 + 8.9] m is in the first section only
-  OdometryOutput o = od->Step(Cycle(1'100, 0, 0));
-  EXPECT_EQ(o.margin_mm, 8'912);
-  EXPECT_EQ(od->machine().state().max_compensation_cycles, 200);
-
-  // starting at 995 m: the fixed point at Create reaches the steep section (995 + 8.9 m)
-  cfg.initial_front_mm = 995'000;
-  auto od2 = Make(cfg);
-  o = od2->Step(Cycle(1'100, 0, 0));
-  EXPECT_EQ(o.margin_mm, 77'561);
-  EXPECT_EQ(od2->machine().state().max_compensation_cycles, 200);
-  EXPECT_EQ(o.front_error_mm, 77'561);
-
-  // at 1125 m with M_prev = 77.561 m the range reaches 1202.6 m: the 10 s section limits
-  cfg.initial_front_mm = 1'125'000;
-  auto od3 = Make(cfg);
-  o = od3->Step(Cycle(1'100, 0, 0));
-  EXPECT_EQ(o.margin_mm, 77'561);
-  EXPECT_EQ(od3->machine().state().max_compensation_cycles, 100);
-  // far into the third section: its own limits
-  cfg.initial_front_mm = 2'000'000;
-  auto od4 = Make(cfg);
-  o = od4->Step(Cycle(1'100, 0, 0));
-  EXPECT_EQ(o.margin_mm, 2'014);
-  EXPECT_EQ(od4->machine().state().max_compensation_cycles, 100);
+  struct Case {
+    std::int64_t front_mm;
+    std::int64_t margin_mm;
+    std::int32_t max_compensation_cycles;
+    const char* where;
+    std::optional<std::int64_t> front_error_mm = std::nullopt;  // checked if given
+  };
+  for (const Case& k : {
+           // at rest at 900 m: [840 - 8.9, 900 + 8.9] m is in the first section only
+           Case{900'000, 8'912, 200, "900 m"},
+           // starting at 995 m: the fixed point at Create reaches the steep section (995 + 8.9 m)
+           Case{995'000, 77'561, 200, "995 m", 77'561},
+           // at 1125 m with M_prev = 77.561 m the range reaches 1202.6 m: the 10 s section limits
+           Case{1'125'000, 77'561, 100, "1125 m"},
+           // far into the third section: its own limits
+           Case{2'000'000, 2'014, 100, "2000 m"},
+       }) {
+    cfg.initial_front_mm = k.front_mm;
+    auto od = Make(cfg);
+    const OdometryOutput o = od->Step(Cycle(1'100, 0, 0));
+    EXPECT_EQ(o.margin_mm, k.margin_mm) << k.where;
+    EXPECT_EQ(od->machine().state().max_compensation_cycles, k.max_compensation_cycles) << k.where;
+    if (k.front_error_mm) {
+      EXPECT_EQ(o.front_error_mm, *k.front_error_mm) << k.where;
+    }
+  }
 }
 
 // An explicit section margin above the error model is used as given.

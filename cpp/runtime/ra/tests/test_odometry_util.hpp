@@ -29,20 +29,18 @@ inline std::vector<OdometrySection> LevelLine() {
 }
 
 inline OdometryConfig Config(const std::vector<OdometrySection>& sections, Method method = Method::kImu) {
-  OdometryConfig c;
-  c.method = method;
-  c.wheel_diameter_um = 860'000;
-  c.train_length_mm = kTrainLengthMm;
-  c.detect_threshold_mm_s2 = 340;
-  c.start_points = 2;
-  c.imu_rate_error_udeg_s = 2'500;
-  c.length_correction_ppm = 1'000;
-  c.accel_max_mm_s2 = 920;
-  c.decel_max_mm_s2 = 1'400;
-  c.sections = sections.data();
-  c.section_count = static_cast<int>(sections.size());
-  c.initial_front_mm = kInitialFrontMm;
-  return c;
+  return OdometryConfig{.method = method,
+                        .wheel_diameter_um = 860'000,
+                        .train_length_mm = kTrainLengthMm,
+                        .detect_threshold_mm_s2 = 340,
+                        .start_points = 2,
+                        .imu_rate_error_udeg_s = 2'500,
+                        .length_correction_ppm = 1'000,
+                        .accel_max_mm_s2 = 920,
+                        .decel_max_mm_s2 = 1'400,
+                        .sections = sections.data(),
+                        .section_count = static_cast<int>(sections.size()),
+                        .initial_front_mm = kInitialFrontMm};
 }
 
 inline std::unique_ptr<Odometry> Make(const OdometryConfig& cfg) {
@@ -56,6 +54,14 @@ inline std::unique_ptr<Odometry> Make(const OdometryConfig& cfg) {
 struct ImuValues {
   double ax = 0, ay = 0, az = kG, wx = 0, wy = 0, wz = 0;
 };
+
+// At rest or at a constant speed on a constant gradient theta (rad): gravity along x and z.
+inline ImuValues OnGradient(double theta) {
+  ImuValues m;
+  m.ax = kG * std::sin(theta);
+  m.az = kG * std::cos(theta);
+  return m;
+}
 
 // Train kinematics of one cycle: constant train acceleration `a`; the wheel's slip speed
 // (wheel peripheral speed minus train speed) goes linearly to `slip_end` (m/s) over the cycle.
@@ -75,14 +81,8 @@ inline CycleInput Cycle(std::int64_t time_ms, std::int64_t pulses, std::int64_t 
   in.tg.pulses = pulses;
   in.tg.last_edge_us = edge_us;
   for (int j = 0; j < kImuSamplesPerCycle; ++j) {
-    ImuSample& s = in.imu[static_cast<std::size_t>(j)];
-    s.time_us = time_ms * 1000 - (9 - j) * 10'000;
-    s.ax = m.ax;
-    s.ay = m.ay;
-    s.az = m.az;
-    s.wx = m.wx;
-    s.wy = m.wy;
-    s.wz = m.wz;
+    const std::int64_t t_us = time_ms * 1000 - (9 - j) * 10'000;
+    in.imu[static_cast<std::size_t>(j)] = ImuSample{t_us, m.ax, m.ay, m.az, m.wx, m.wy, m.wz};
   }
   return in;
 }

@@ -14,7 +14,9 @@
 // FAULT_RA_TG_FAILURE_IGNORED (ctest unit_fault_<F>: these tests against the schemata variant with the fault selected).
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cstdint>
+#include <initializer_list>
 
 #include "railproof/testing/enum_names.hpp"
 #include "railproof/testing/alloc_counter.hpp"
@@ -71,29 +73,54 @@ const MachineState& Judge(ReadhesionMachine& m, bool sa0, bool sa1, SectionLimit
   return Cycle(m, In(false, s, sa0, sa1));
 }
 
+// Detects, then judges one compensating cycle per entry (the speed agreement of each
+// candidate); the state after the last.
+const MachineState& DetectThenJudge(ReadhesionMachine& m, std::initializer_list<std::array<bool, 2>> agreements) {
+  Detect(m);
+  for (const std::array<bool, 2>& a : agreements) {
+    Judge(m, a[0], a[1]);
+  }
+  return m.state();
+}
+
+// Step 6: the stopped state with its reason, the stop demand and the position invalid.
+void ExpectStopped(const MachineState& s, StopReason reason) {
+  EXPECT_EQ(s.mode, Mode::kStopped);
+  EXPECT_EQ(s.stop_reason, reason);
+  EXPECT_TRUE(s.stop_demand);
+  EXPECT_FALSE(s.position_valid);
+}
+
+// Step 5: candidate `adopted` taken, back in TG odometry, every candidate discarded.
+void ExpectAdopted(const MachineState& s, std::int8_t adopted) {
+  EXPECT_EQ(s.adopted, adopted);
+  EXPECT_EQ(s.mode, Mode::kTg);
+  EXPECT_FALSE(s.candidates[0].active);
+  EXPECT_FALSE(s.candidates[1].active);
+}
+
 // @verifies REQ-RA-003
 // @verifies REQ-RA-010
 TEST(OdometryReadhesionMachine, ConfigurationValidation) {
-  EXPECT_EQ(ReadhesionMachine::Validate(Config()), MachineError::kNone);
-  EXPECT_EQ(ReadhesionMachine::Validate(Config(1)), MachineError::kNone);
-  MachineConfig c = Config();
-  c.confirm_cycles = 0;
-  EXPECT_EQ(ReadhesionMachine::Validate(c), MachineError::kConfirmCyclesInvalid);
-  c.confirm_cycles = 101;
-  EXPECT_EQ(ReadhesionMachine::Validate(c), MachineError::kConfirmCyclesInvalid);
-  c.confirm_cycles = 100;
-  EXPECT_EQ(ReadhesionMachine::Validate(c), MachineError::kNone);
-  c = Config(0);
-  EXPECT_EQ(ReadhesionMachine::Validate(c), MachineError::kStartPointsInvalid);
-  c = Config(3);
-  EXPECT_EQ(ReadhesionMachine::Validate(c), MachineError::kStartPointsInvalid);
-  c = Config();
-  c.spacing_cycles = 0;
-  EXPECT_EQ(ReadhesionMachine::Validate(c), MachineError::kSpacingInvalid);
-  c.spacing_cycles = 10001;
-  EXPECT_EQ(ReadhesionMachine::Validate(c), MachineError::kSpacingInvalid);
-  c.spacing_cycles = 10000;
-  EXPECT_EQ(ReadhesionMachine::Validate(c), MachineError::kNone);
+  struct Case {
+    std::uint8_t points;
+    std::uint8_t confirm;
+    std::int32_t spacing;
+    MachineError expected;
+  };
+  for (const Case& k : {Case{2, 3, kSpacing, MachineError::kNone}, Case{1, 3, kSpacing, MachineError::kNone},
+                        Case{2, 0, kSpacing, MachineError::kConfirmCyclesInvalid},
+                        Case{2, 101, kSpacing, MachineError::kConfirmCyclesInvalid},
+                        Case{2, 100, kSpacing, MachineError::kNone},
+                        Case{0, 3, kSpacing, MachineError::kStartPointsInvalid},
+                        Case{3, 3, kSpacing, MachineError::kStartPointsInvalid},
+                        Case{2, 3, 0, MachineError::kSpacingInvalid}, Case{2, 3, 10001, MachineError::kSpacingInvalid},
+                        Case{2, 3, 10000, MachineError::kNone}}) {
+    MachineConfig c = Config(k.points, k.confirm);
+    c.spacing_cycles = k.spacing;
+    EXPECT_EQ(ReadhesionMachine::Validate(c), k.expected)
+        << "points " << int{k.points} << ", confirm " << int{k.confirm} << ", spacing " << k.spacing;
+  }
   // the reference configuration (spec/parameters/ra.yaml)
   MachineConfig ref;
   ref.confirm_cycles = static_cast<std::uint8_t>(prm::confirm_cycles);
@@ -231,10 +258,7 @@ TEST(OdometryReadhesionMachine, StartPointsOlderThanTmaxDiscardedAtDetection) {
   ReadhesionMachine old(Config());
   const MachineState& t = Detect(old, kTight, 41);
   EXPECT_TRUE(t.detected);
-  EXPECT_EQ(t.mode, Mode::kStopped);
-  EXPECT_EQ(t.stop_reason, StopReason::kMaxCompensationTime);
-  EXPECT_TRUE(t.stop_demand);
-  EXPECT_FALSE(t.position_valid);
+  ExpectStopped(t, StopReason::kMaxCompensationTime);
   EXPECT_FALSE(t.candidates[0].active);
 }
 
@@ -252,10 +276,7 @@ TEST(OdometryReadhesionMachine, TimeoutAtTmaxPlusOne) {
   }
   EXPECT_EQ(m.state().candidates[0].age_cycles, kTight.max_compensation_cycles);
   const MachineState& s = Cycle(m, In(true, kTight));
-  EXPECT_EQ(s.mode, Mode::kStopped);
-  EXPECT_EQ(s.stop_reason, StopReason::kMaxCompensationTime);
-  EXPECT_TRUE(s.stop_demand);
-  EXPECT_FALSE(s.position_valid);
+  ExpectStopped(s, StopReason::kMaxCompensationTime);
   EXPECT_FALSE(s.candidates[0].active);
 }
 
@@ -292,10 +313,7 @@ TEST(OdometryReadhesionMachine, ReadhesionAfterConfirmCycles) {
   EXPECT_EQ(two.candidates[1].confirm, 0);
   EXPECT_EQ(two.adopted, kNoCandidate);
   const MachineState& s = Judge(m, true, false);
-  EXPECT_EQ(s.mode, Mode::kTg);
-  EXPECT_EQ(s.adopted, 0);
-  EXPECT_FALSE(s.candidates[0].active);
-  EXPECT_FALSE(s.candidates[1].active);
+  ExpectAdopted(s, 0);
   EXPECT_EQ(s.deviation_count, 0);
   EXPECT_FALSE(s.stop_demand);
   EXPECT_TRUE(s.position_valid);
@@ -322,9 +340,7 @@ TEST(OdometryReadhesionMachine, SpeedDisagreementRestartsTheConfirmation) {
 // @verifies REQ-RA-006
 TEST(OdometryReadhesionMachine, DeviationRestartsTheConfirmation) {
   ReadhesionMachine m(Config());
-  Detect(m);
-  Judge(m, true, true);
-  Judge(m, true, true);
+  DetectThenJudge(m, {{true, true}, {true, true}});
   const MachineState& s = Cycle(m, In(true, kNormal, true, true));
   EXPECT_EQ(s.mode, Mode::kCompensating);
   EXPECT_EQ(s.candidates[0].confirm, 0);
@@ -335,27 +351,14 @@ TEST(OdometryReadhesionMachine, DeviationRestartsTheConfirmation) {
 // @verifies REQ-RA-010
 TEST(OdometryReadhesionMachine, BothConfirmInOneCyclePrimaryAdopted) {
   ReadhesionMachine m(Config());
-  Detect(m);
-  Judge(m, true, true);
-  Judge(m, true, true);
-  const MachineState& s = Judge(m, true, true);
-  EXPECT_EQ(s.adopted, 0);
-  EXPECT_EQ(s.mode, Mode::kTg);
-  EXPECT_FALSE(s.candidates[1].active);
+  ExpectAdopted(DetectThenJudge(m, {{true, true}, {true, true}, {true, true}}), 0);
 }
 
 // The second start point completes first (the primary one cycle short) and is adopted.
 // @verifies REQ-RA-010
 TEST(OdometryReadhesionMachine, SecondStartPointAdoptedWhenFirst) {
   ReadhesionMachine m(Config());
-  Detect(m);
-  Judge(m, false, true);
-  Judge(m, true, true);
-  const MachineState& s = Judge(m, true, true);
-  EXPECT_EQ(s.adopted, 1);
-  EXPECT_EQ(s.mode, Mode::kTg);
-  EXPECT_FALSE(s.candidates[0].active);
-  EXPECT_FALSE(s.candidates[1].active);
+  ExpectAdopted(DetectThenJudge(m, {{false, true}, {true, true}, {true, true}}), 1);
 }
 
 // Step 1: during an episode the margin in force only grows and t_max only shrinks; in TG
@@ -401,11 +404,7 @@ TEST(OdometryReadhesionMachine, TightSectionTimesOutTheEpisode) {
   }
   EXPECT_EQ(m.state().candidates[0].age_cycles, 40);
   EXPECT_EQ(m.state().mode, Mode::kCompensating);
-  const MachineState& s = Cycle(m, In(true, kTight));  // 41 > 40
-  EXPECT_EQ(s.mode, Mode::kStopped);
-  EXPECT_EQ(s.stop_reason, StopReason::kMaxCompensationTime);
-  EXPECT_TRUE(s.stop_demand);
-  EXPECT_FALSE(s.position_valid);
+  ExpectStopped(Cycle(m, In(true, kTight)), StopReason::kMaxCompensationTime);  // 41 > 40
 }
 
 // Step 2 in each mode: the safe reaction in the same cycle, IMU checked first.
@@ -417,21 +416,14 @@ TEST(OdometryReadhesionMachine, SensorFailureInEveryMode) {
     Predicates p = In(true);
     p.imu_ok = false;
     const MachineState& s = Cycle(m, p);
-    EXPECT_EQ(s.mode, Mode::kStopped);
-    EXPECT_EQ(s.stop_reason, StopReason::kImuFailure);
-    EXPECT_TRUE(s.stop_demand);
-    EXPECT_FALSE(s.position_valid);
+    ExpectStopped(s, StopReason::kImuFailure);
     EXPECT_EQ(s.deviation_count, 0);
   }
   {  // TG odometry, TG
     ReadhesionMachine m(Config());
     Predicates p = In(false);
     p.tg_ok = false;
-    const MachineState& s = Cycle(m, p);
-    EXPECT_EQ(s.mode, Mode::kStopped);
-    EXPECT_EQ(s.stop_reason, StopReason::kTgFailure);
-    EXPECT_TRUE(s.stop_demand);
-    EXPECT_FALSE(s.position_valid);
+    ExpectStopped(Cycle(m, p), StopReason::kTgFailure);
   }
   {  // compensating, TG: every candidate discarded
     ReadhesionMachine m(Config());
@@ -439,13 +431,10 @@ TEST(OdometryReadhesionMachine, SensorFailureInEveryMode) {
     Predicates p = In(false, kNormal, true, true);
     p.tg_ok = false;
     const MachineState& s = Cycle(m, p);
-    EXPECT_EQ(s.mode, Mode::kStopped);
-    EXPECT_EQ(s.stop_reason, StopReason::kTgFailure);
+    ExpectStopped(s, StopReason::kTgFailure);
     EXPECT_FALSE(s.candidates[0].active);
     EXPECT_FALSE(s.candidates[1].active);
     EXPECT_EQ(s.adopted, kNoCandidate);
-    EXPECT_TRUE(s.stop_demand);
-    EXPECT_FALSE(s.position_valid);
   }
   {  // compensating, IMU
     ReadhesionMachine m(Config());
@@ -480,10 +469,7 @@ TEST(OdometryReadhesionMachine, StoppedHeldUntilABalise) {
   Detect(m, kTight, 41);
   for (int k = 0; k < 3; ++k) {
     const MachineState& s = Cycle(m, In(true));
-    EXPECT_EQ(s.mode, Mode::kStopped);
-    EXPECT_EQ(s.stop_reason, StopReason::kMaxCompensationTime);
-    EXPECT_TRUE(s.stop_demand);
-    EXPECT_FALSE(s.position_valid);
+    ExpectStopped(s, StopReason::kMaxCompensationTime);
     EXPECT_FALSE(s.balise_reset);
   }
   Predicates p = In(false);

@@ -14,13 +14,12 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <set>
 #include <array>
-#include <atomic>
+#include <cstddef>
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
-#include <sstream>
+#include <set>
 #include <string>
 #include <utility>
 #include <vector>
@@ -54,8 +53,6 @@ constexpr std::size_t kCorruptStride = 7;
 static_assert(kCorruptSymbols * kCorruptStride <= rr::kBlockBytes);
 
 rc::VectorSet g_set;
-std::atomic<std::size_t> g_mismatched{0};
-std::atomic<std::size_t> g_replayed{0};
 
 struct Mismatch {
   std::size_t step;
@@ -100,17 +97,10 @@ class StepChecker {
 };
 
 rr::EndpointConfig ConfigFor(const rc::FileHeader& h, rr::Role role) {
-  rr::EndpointConfig c{};
+  rr::EndpointConfig c = h.endpoint;
   c.role = role;
   c.own_id = role == rr::Role::kGround ? h.ground_id : h.train_id;
   c.peer_id = role == rr::Role::kGround ? h.train_id : h.ground_id;
-  c.seq_modulus = h.seq_modulus;
-  c.seq_window = h.seq_window;
-  c.history_depth = h.history_depth;
-  c.turnaround_ms = h.turnaround_ms;
-  c.link_timeout_ms = h.link_timeout_ms;
-  c.echo_validity_ms = h.echo_validity_ms;
-  c.initial_seq = h.init_own_seq;
   return c;
 }
 
@@ -192,40 +182,27 @@ std::vector<Mismatch> Replay(const rc::Vector& v, const rc::FileHeader& h, std::
   return mismatches;
 }
 
-class VectorTest : public testing::Test {
- public:
-  explicit VectorTest(std::size_t index) : index_(index) {}
-  void TestBody() override {
-    const rc::Vector& v = g_set.vectors[index_];
-    const rc::FileHeader& h = g_set.headers[v.header_index];
-    RecordProperty("vector_id", v.id);
-    std::string reqs;
-    for (const auto& r : v.requirements) {
-      reqs += (reqs.empty() ? "" : " ") + r;
-    }
-    RecordProperty("requirements", reqs);
-    RecordProperty("goal", v.goal);
-    std::string setup_error;
-    g_replayed.fetch_add(1);
-    const auto mismatches = Replay(v, h, setup_error);
-    if (!setup_error.empty()) {
-      g_mismatched.fetch_add(1);
-      ADD_FAILURE_AT(v.file.c_str(), static_cast<int>(v.line)) << "vector " << v.id << ": " << setup_error;
-      return;
-    }
-    if (!mismatches.empty()) {
-      g_mismatched.fetch_add(1);
-    }
-    for (const Mismatch& m : mismatches) {
-      ADD_FAILURE_AT(v.file.c_str(), static_cast<int>(v.line))
-          << "vector " << v.id << " step " << m.step << " (" << m.ev << "): field " << m.field << ": expected "
-          << m.expected << ", actual " << m.actual;
-    }
+// Replays vector i: its requirements and goal are recorded with the test; a setup error or
+// each mismatch of the first diverging step is a problem.
+void ReplayVector(std::size_t i, std::vector<std::string>& problems) {
+  const rc::Vector& v = g_set.vectors[i];
+  std::string reqs;
+  for (const auto& r : v.requirements) {
+    reqs += (reqs.empty() ? "" : " ") + r;
   }
-
- private:
-  std::size_t index_;
-};
+  testing::Test::RecordProperty("requirements", reqs);
+  testing::Test::RecordProperty("goal", v.goal);
+  std::string setup_error;
+  const auto mismatches = Replay(v, g_set.headers[v.header_index], setup_error);
+  if (!setup_error.empty()) {
+    problems.push_back(setup_error);
+    return;
+  }
+  for (const Mismatch& m : mismatches) {
+    problems.push_back("step " + std::to_string(m.step) + " (" + m.ev + "): field " + m.field + ": expected " +
+                       m.expected + ", actual " + m.actual);
+  }
+}
 
 }  // namespace
 
@@ -247,6 +224,5 @@ int main(int argc, char** argv) {
         }
         return rcli::LoadedSet{loaded.ok, loaded.error, g_set.vectors.size(), files.size()};
       },
-      [](std::size_t i) { return rcli::SiteOf(g_set.vectors, i); },
-      [](std::size_t i) -> testing::Test* { return new VectorTest(i); }, g_mismatched, g_replayed);
+      [](std::size_t i) { return rcli::SiteOf(g_set.vectors, i); }, ReplayVector);
 }

@@ -191,13 +191,14 @@ FileHeader ParseHeader(const json& h, const std::string& file) {
   }
   const json& p = Field(h, "parameters", "");
   const std::string wp = "parameters";
-  fh.seq_modulus = Unsigned(p, "seq_modulus", wp, rr::kSeqModulusMax);
-  fh.seq_window = U32(p, "seq_window", wp);
-  fh.history_depth = U32(p, "history_depth", wp);
-  fh.turnaround_ms = U32(p, "turnaround_ms", wp);
-  fh.link_timeout_ms = U32(p, "link_timeout_ms", wp);
-  fh.echo_validity_ms = U32(p, "echo_validity_ms", wp);
-  fh.init_own_seq = U32(p, "init_own_seq", wp);
+  rr::EndpointConfig& e = fh.endpoint;
+  e.seq_modulus = Unsigned(p, "seq_modulus", wp, rr::kSeqModulusMax);
+  e.seq_window = U32(p, "seq_window", wp);
+  e.history_depth = U32(p, "history_depth", wp);
+  e.turnaround_ms = U32(p, "turnaround_ms", wp);
+  e.link_timeout_ms = U32(p, "link_timeout_ms", wp);
+  e.echo_validity_ms = U32(p, "echo_validity_ms", wp);
+  e.initial_seq = U32(p, "init_own_seq", wp);
   fh.ground_id = U16(p, "ground_id", wp);
   fh.train_id = U16(p, "train_id", wp);
   return fh;

@@ -40,13 +40,8 @@ struct FileHeader {
   std::string model_sha256;
   std::string generator;
   std::uint32_t time_ms_per_tick = 0;
-  std::uint64_t seq_modulus = 0;
-  std::uint32_t seq_window = 0;
-  std::uint32_t history_depth = 0;
-  std::uint32_t turnaround_ms = 0;
-  std::uint32_t link_timeout_ms = 0;
-  std::uint32_t echo_validity_ms = 0;
-  std::uint32_t init_own_seq = 0;
+  // the endpoint parameters (init_own_seq as initial_seq); role and ids are the vector's
+  tg::EndpointConfig endpoint{};
   std::uint16_t ground_id = 0;
   std::uint16_t train_id = 0;
 };

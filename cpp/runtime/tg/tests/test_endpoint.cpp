@@ -20,6 +20,7 @@
 #include "railproof/tg/frame.hpp"
 #include "railproof/tg/telegram.hpp"
 #include "railproof/testing/alloc_counter.hpp"
+#include "test_keys.hpp"
 
 // Allocation counter (REQ-TG-018: no heap per telegram): cpp/testing/src/alloc_counter.cpp.
 
@@ -31,9 +32,7 @@ namespace p = params::tg;
 constexpr std::array<std::uint8_t, kKeyBytes> kLinkKeyBytes = {
     0x4c, 0x69, 0x6e, 0x6b, 0x2d, 0x6b, 0x65, 0x79, 0x2d, 0x75, 0x6e, 0x69, 0x74, 0x2d, 0x74, 0x65,
     0x73, 0x74, 0x11, 0x22, 0x33, 0x44, 0x55, 0x66, 0x77, 0x88, 0x99, 0xaa, 0xbb, 0xcc, 0xdd, 0xee};
-constexpr std::array<std::uint8_t, kKeyBytes> kAttackerKeyBytes = {
-    0x4c, 0x69, 0x6e, 0x6b, 0x2d, 0x6b, 0x65, 0x79, 0x2d, 0x75, 0x6e, 0x69, 0x74, 0x2d, 0x74, 0x65,
-    0x73, 0x74, 0x11, 0x22, 0x33, 0x44, 0x55, 0x66, 0x77, 0x88, 0x99, 0xaa, 0xbb, 0xcc, 0xdd, 0xef};
+constexpr std::array<std::uint8_t, kKeyBytes> kAttackerKeyBytes = test::OneBitApart(kLinkKeyBytes);
 
 constexpr auto kGroundId = static_cast<std::uint16_t>(p::ground_id);
 constexpr auto kTrainId = static_cast<std::uint16_t>(p::model::model_train_id);
@@ -104,6 +103,12 @@ class Harness {
     return ep.Receive(now, f.View(), payload);
   }
   Endpoint::RxResult Rx(std::uint32_t now, const PeerTelegram& t) { return Rx(now, Seal(t)); }
+  // The cycles exactly at the link timeout after a receipt at `ta` (the link still up) and
+  // 1 ms later (lost).
+  std::array<Endpoint::CycleOutput, 2> CyclesAtTimeout(std::uint32_t ta) {
+    const Endpoint::CycleOutput at = Cycle(ta + kLinkTimeout);
+    return {at, Cycle(ta + kLinkTimeout + 1U)};
+  }
 
   [[nodiscard]] bool PayloadIs(std::span<const std::uint8_t> want) const {
     return std::equal(want.begin(), want.end(), payload.begin()) &&
@@ -393,13 +398,12 @@ TEST(EndpointTurnaround, AgeOfAnOlderEchoedNumber) {
 TEST(EndpointLink, TimeoutExactlyAtLimitStaysUpOneMsLaterIsLost) {
   const std::uint32_t ta = 20000;
   Harness train = TrainUp(ta, 3, 77);
-  auto c = train.Cycle(ta + kLinkTimeout);
+  const auto [c, c1] = train.CyclesAtTimeout(ta);
   EXPECT_EQ(c.link, LinkState::kUp);
   EXPECT_FALSE(c.emergency_brake);
-  c = train.Cycle(ta + kLinkTimeout + 1U);
-  EXPECT_EQ(c.link, LinkState::kLost);
-  EXPECT_TRUE(c.emergency_brake);
-  EXPECT_TRUE(c.tracking_abnormal);
+  EXPECT_EQ(c1.link, LinkState::kLost);
+  EXPECT_TRUE(c1.emergency_brake);
+  EXPECT_TRUE(c1.tracking_abnormal);
 
   // Ground role: tracking abnormal at the same boundary.
   Harness ground(GroundConfig(3));
@@ -408,12 +412,11 @@ TEST(EndpointLink, TimeoutExactlyAtLimitStaysUpOneMsLaterIsLost) {
                                        .dst = kGroundId})
                 .reason,
             RejectReason::kNone);
-  auto g = ground.Cycle(ta + kLinkTimeout);
+  const auto [g, g1] = ground.CyclesAtTimeout(ta);
   EXPECT_EQ(g.link, LinkState::kUp);
   EXPECT_FALSE(g.tracking_abnormal);
-  g = ground.Cycle(ta + kLinkTimeout + 1U);
-  EXPECT_EQ(g.link, LinkState::kLost);
-  EXPECT_TRUE(g.tracking_abnormal);
+  EXPECT_EQ(g1.link, LinkState::kLost);
+  EXPECT_TRUE(g1.tracking_abnormal);
 }
 
 // @verifies REQ-TG-013
@@ -744,8 +747,9 @@ TEST(EndpointTime, ClockWrapIsHandledByWrapSafeDifferences) {
   EXPECT_EQ(r.reason, RejectReason::kNone);
   const std::uint32_t ta = t0 + kTurnaround + 1U;  // = 2000 after the wrap
   EXPECT_LT(ta, t0);
-  EXPECT_EQ(h.Cycle(ta + kLinkTimeout).link, LinkState::kUp);
-  EXPECT_EQ(h.Cycle(ta + kLinkTimeout + 1U).link, LinkState::kLost);
+  const auto [at, after] = h.CyclesAtTimeout(ta);
+  EXPECT_EQ(at.link, LinkState::kUp);
+  EXPECT_EQ(after.link, LinkState::kLost);
 
   // Link timeout across the wrap itself.
   Harness w = TrainUp(0xFFFFFFFFU - 100U, 0, 10);

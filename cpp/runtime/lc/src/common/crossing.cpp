@@ -12,12 +12,12 @@ namespace railproof::lc {
 
 using core::RestrictionSegment;
 
-// @implements REQ-LC-001 REQ-LC-014
+// @implements REQ-LC-001 REQ-LC-010 REQ-LC-012 REQ-LC-014
 bool PositionOk(std::int64_t x) noexcept {
   return x >= -core::kMaxPositionMm && x <= core::kMaxPositionMm;
 }
 
-// @implements REQ-LC-005 REQ-LC-014
+// @implements REQ-LC-005 REQ-LC-006 REQ-LC-008 REQ-LC-013 REQ-LC-014
 bool ClockOk(std::int64_t t) noexcept { return t >= -kMaxClockMs && t <= kMaxClockMs; }
 
 // @implements REQ-LC-001

@@ -84,10 +84,7 @@ ProtectionError CrossingProtection::AddCrossing(const CrossingData& crossing) no
       return ProtectionError::kCrossingOverlap;
     }
   }
-  CrossingEntry entry;
-  entry.data = crossing;
-  entries_[count_] = entry;
-  ++count_;
+  Append(crossing);
   ComputeOutputs();
   return ProtectionError::kNone;
 }
@@ -101,13 +98,18 @@ ProtectionError CrossingProtection::LoadCrossings(std::span<const CrossingData> 
     return FromDataError(check.error);
   }
   for (const CrossingData& c : crossings) {
-    CrossingEntry entry;
-    entry.data = c;
-    entries_[count_] = entry;
-    ++count_;
+    Append(c);
   }
   ComputeOutputs();
   return ProtectionError::kNone;
+}
+
+// @implements REQ-LC-001
+void CrossingProtection::Append(const CrossingData& crossing) noexcept {
+  CrossingEntry entry;
+  entry.data = crossing;
+  entries_[count_] = entry;
+  ++count_;
 }
 
 // @implements REQ-LC-004
@@ -125,22 +127,12 @@ void CrossingProtection::DropDone() noexcept {
 
 // @implements REQ-LC-002 REQ-LC-003
 const CrossingEntry* CrossingProtection::Find(std::uint32_t crossing_id) const noexcept {
-  for (std::size_t i = 0; i < count_; ++i) {
-    if (entries_[i].data.id == crossing_id) {
-      return &entries_[i];
-    }
-  }
-  return nullptr;
+  return FindCrossing(std::span<const CrossingEntry>(entries_.data(), count_), crossing_id);
 }
 
 // @implements REQ-LC-002 REQ-LC-003
 CrossingEntry* CrossingProtection::FindMutable(std::uint32_t crossing_id) noexcept {
-  for (std::size_t i = 0; i < count_; ++i) {
-    if (entries_[i].data.id == crossing_id) {
-      return &entries_[i];
-    }
-  }
-  return nullptr;
+  return FindCrossing(std::span<CrossingEntry>(entries_.data(), count_), crossing_id);
 }
 
 // Step 4 of design §3 and the messages to send.

@@ -12,13 +12,7 @@ namespace railproof::lc::wayside {
 
 namespace {
 
-// @implements REQ-LC-008 REQ-LC-013
-bool ClockOk(std::int64_t t) noexcept { return t >= -lc::kMaxClockMs && t <= lc::kMaxClockMs; }
-
-// @implements REQ-LC-010 REQ-LC-012
-bool PositionOk(std::int64_t x) noexcept {
-  return x >= -core::kMaxPositionMm && x <= core::kMaxPositionMm;
-}
+// The range checks of times and positions are lc::ClockOk and lc::PositionOk (common part).
 
 // @implements REQ-LC-008 REQ-LC-010
 // st = t + eta - warning_time - allowance (design §5 steps 1 and 4), eta finite.
@@ -53,22 +47,12 @@ CentreScheduler::CreateResult CentreScheduler::Create(const SchedulerConfig& con
 
 // @implements REQ-LC-008
 const ScheduledCrossing* CentreScheduler::Find(std::uint32_t crossing_id) const noexcept {
-  for (std::size_t i = 0; i < count_; ++i) {
-    if (crossings_[i].data.id == crossing_id) {
-      return &crossings_[i];
-    }
-  }
-  return nullptr;
+  return FindCrossing(std::span<const ScheduledCrossing>(crossings_.data(), count_), crossing_id);
 }
 
 // @implements REQ-LC-008
 ScheduledCrossing* CentreScheduler::FindMutable(std::uint32_t crossing_id) noexcept {
-  for (std::size_t i = 0; i < count_; ++i) {
-    if (crossings_[i].data.id == crossing_id) {
-      return &crossings_[i];
-    }
-  }
-  return nullptr;
+  return FindCrossing(std::span<ScheduledCrossing>(crossings_.data(), count_), crossing_id);
 }
 
 // Design §5 step 1 (REQ-LC-008).

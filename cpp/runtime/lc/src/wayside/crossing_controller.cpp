@@ -10,12 +10,7 @@
 
 namespace railproof::lc::wayside {
 
-namespace {
-
-// @implements REQ-LC-006 REQ-LC-013
-bool ClockOk(std::int64_t t) noexcept { return t >= -lc::kMaxClockMs && t <= lc::kMaxClockMs; }
-
-}  // namespace
+// The range check of times is lc::ClockOk (common part).
 
 // @implements REQ-LC-006 REQ-LC-007 REQ-LC-013
 ControllerConfig DefaultControllerConfig(std::uint32_t crossing_id) noexcept {

@@ -141,13 +141,8 @@ ConfigError Ground::Init(const LineConfig& line, const Capacity& cap, std::size_
   if (line.points.size() > cap.points) {
     return ConfigError::kTooManyPoints;
   }
-  for (std::size_t i = 0; i < line.points.size(); ++i) {
-    for (std::size_t j = 0; j < i; ++j) {
-      if (line.points[j].id == line.points[i].id) {
-        entry = i;
-        return ConfigError::kPointsIdDuplicate;
-      }
-    }
+  if (!UniqueIds(line.points, entry)) {
+    return ConfigError::kPointsIdDuplicate;
   }
   for (std::size_t i = 0; i < line.points.size(); ++i) {
     const Section& s = line.points[i].section;
@@ -165,13 +160,8 @@ ConfigError Ground::Init(const LineConfig& line, const Capacity& cap, std::size_
   if (line.routes.size() > cap.routes) {
     return ConfigError::kTooManyRoutes;
   }
-  for (std::size_t i = 0; i < line.routes.size(); ++i) {
-    for (std::size_t j = 0; j < i; ++j) {
-      if (line.routes[j].id == line.routes[i].id) {
-        entry = i;
-        return ConfigError::kRouteIdDuplicate;
-      }
-    }
+  if (!UniqueIds(line.routes, entry)) {
+    return ConfigError::kRouteIdDuplicate;
   }
   for (std::size_t i = 0; i < line.routes.size(); ++i) {
     const RouteConfig& r = line.routes[i];
@@ -188,13 +178,8 @@ ConfigError Ground::Init(const LineConfig& line, const Capacity& cap, std::size_
   if (line.handovers.size() > cap.handovers) {
     return ConfigError::kTooManyHandovers;
   }
-  for (std::size_t i = 0; i < line.handovers.size(); ++i) {
-    for (std::size_t j = 0; j < i; ++j) {
-      if (line.handovers[j].id == line.handovers[i].id) {
-        entry = i;
-        return ConfigError::kHandoverIdDuplicate;
-      }
-    }
+  if (!UniqueIds(line.handovers, entry)) {
+    return ConfigError::kHandoverIdDuplicate;
   }
   for (std::size_t i = 0; i < line.handovers.size(); ++i) {
     const std::int64_t pos = line.handovers[i].position_mm;

@@ -207,26 +207,13 @@ CommandStatus Ground::FreeRoute(std::uint32_t route_id) noexcept {
 
 // @implements REQ-MB-014
 CommandResult Ground::RequestPossession(Section range) noexcept {
-  if (!SectionOnLine(range)) {
-    return CommandResult{CommandStatus::kInvalidRange, 0};
-  }
-  if (possessions_.Full()) {
-    return CommandResult{CommandStatus::kCapacityExceeded, 0};
-  }
-  const std::uint32_t id = next_possession_id_++;
-  (void)possessions_.PushBack(PossessionEntry{id, range, false});
-  return CommandResult{CommandStatus::kAccepted, id};
+  return AddWithNextId(possessions_, next_possession_id_, SectionOnLine(range),
+                       [&](std::uint32_t id) { return PossessionEntry{id, range, false}; });
 }
 
 // @implements REQ-MB-014
 CommandStatus Ground::CancelPossession(std::uint32_t possession_id) noexcept {
-  for (std::size_t i = 0; i < possessions_.Size(); ++i) {
-    if (possessions_[i].id == possession_id) {
-      possessions_.EraseAt(i);
-      return CommandStatus::kAccepted;
-    }
-  }
-  return CommandStatus::kUnknownId;
+  return EraseById(possessions_, possession_id, [](const PossessionEntry& p) { return p.id; });
 }
 
 // Design §3.3: a requested possession becomes active iff it is not in use.
@@ -269,15 +256,10 @@ CommandStatus Ground::AcceptAtBoundary(bool accepted) noexcept {
 
 // @implements REQ-MB-015
 CommandResult Ground::RequestSpeedRestriction(Section range, std::int64_t speed_mm_s) noexcept {
-  if (!SectionOnLine(range) || speed_mm_s <= 0 || speed_mm_s > kMaxSpeedMmS) {
-    return CommandResult{CommandStatus::kInvalidRange, 0};
-  }
-  if (restrictions_.Full()) {
-    return CommandResult{CommandStatus::kCapacityExceeded, 0};
-  }
-  const std::uint32_t id = next_restriction_id_++;
-  (void)restrictions_.PushBack(Restriction{SpeedRestriction{id, range.begin_mm, range.end_mm, speed_mm_s}, false});
-  return CommandResult{CommandStatus::kAccepted, id};
+  return AddWithNextId(restrictions_, next_restriction_id_,
+                       SectionOnLine(range) && speed_mm_s > 0 && speed_mm_s <= kMaxSpeedMmS, [&](std::uint32_t id) {
+                         return Restriction{SpeedRestriction{id, range.begin_mm, range.end_mm, speed_mm_s}, false};
+                       });
 }
 
 // @implements REQ-MB-015
@@ -296,37 +278,18 @@ CommandStatus Ground::ConfirmSpeedRestriction(std::uint32_t restriction_id) noex
 
 // @implements REQ-MB-015
 CommandStatus Ground::CancelSpeedRestriction(std::uint32_t restriction_id) noexcept {
-  for (std::size_t i = 0; i < restrictions_.Size(); ++i) {
-    if (restrictions_[i].r.id == restriction_id) {
-      restrictions_.EraseAt(i);
-      return CommandStatus::kAccepted;
-    }
-  }
-  return CommandStatus::kUnknownId;
+  return EraseById(restrictions_, restriction_id, [](const Restriction& r) { return r.r.id; });
 }
 
 // @implements REQ-MB-016
 CommandResult Ground::ReportUnequippedOccupancy(Section range) noexcept {
-  if (!SectionOnLine(range)) {
-    return CommandResult{CommandStatus::kInvalidRange, 0};
-  }
-  if (unequipped_.Full()) {
-    return CommandResult{CommandStatus::kCapacityExceeded, 0};
-  }
-  const std::uint32_t id = next_unequipped_id_++;
-  (void)unequipped_.PushBack(Unequipped{id, range});
-  return CommandResult{CommandStatus::kAccepted, id};
+  return AddWithNextId(unequipped_, next_unequipped_id_, SectionOnLine(range),
+                       [&](std::uint32_t id) { return Unequipped{id, range}; });
 }
 
 // @implements REQ-MB-016
 CommandStatus Ground::ClearUnequippedOccupancy(std::uint32_t occupancy_id) noexcept {
-  for (std::size_t i = 0; i < unequipped_.Size(); ++i) {
-    if (unequipped_[i].id == occupancy_id) {
-      unequipped_.EraseAt(i);
-      return CommandStatus::kAccepted;
-    }
-  }
-  return CommandStatus::kUnknownId;
+  return EraseById(unequipped_, occupancy_id, [](const Unequipped& u) { return u.id; });
 }
 
 }  // namespace railproof::mb::wayside

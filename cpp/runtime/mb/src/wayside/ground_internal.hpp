@@ -40,6 +40,21 @@ inline bool ValidSectionList(std::span<const Section> list, std::int64_t length_
   return true;
 }
 
+// False (entry = its index) if an element of `list` (points, routes, handovers) repeats the
+// id of an earlier one.
+template <typename T>
+bool UniqueIds(std::span<const T> list, std::size_t& entry) noexcept {
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    for (std::size_t j = 0; j < i; ++j) {
+      if (list[j].id == list[i].id) {
+        entry = i;
+        return false;
+      }
+    }
+  }
+  return true;
+}
+
 template <typename T>
 bool CopyInto(FixedVector<T>& dst, std::span<const T> src, std::size_t capacity) noexcept {
   if (!dst.Allocate(capacity)) {
@@ -51,6 +66,35 @@ bool CopyInto(FixedVector<T>& dst, std::span<const T> src, std::size_t capacity)
     }
   }
   return true;
+}
+
+// A command adding an entry to a list of the ground (possessions, speed restrictions,
+// unequipped occupancies): kInvalidRange if its arguments are not `valid`, kCapacityExceeded
+// if the list is full, else make(id) with the next id is added: kAccepted with that id.
+template <typename T, typename Make>
+CommandResult AddWithNextId(FixedVector<T>& list, std::uint32_t& next_id, bool valid, Make make) noexcept {
+  if (!valid) {
+    return CommandResult{CommandStatus::kInvalidRange, 0};
+  }
+  if (list.Full()) {
+    return CommandResult{CommandStatus::kCapacityExceeded, 0};
+  }
+  const std::uint32_t id = next_id++;
+  (void)list.PushBack(make(id));
+  return CommandResult{CommandStatus::kAccepted, id};
+}
+
+// A command removing the entry whose id_of(entry) is `id` from such a list: kAccepted, or
+// kUnknownId if there is none.
+template <typename T, typename IdOf>
+CommandStatus EraseById(FixedVector<T>& list, std::uint32_t id, IdOf id_of) noexcept {
+  for (std::size_t i = 0; i < list.Size(); ++i) {
+    if (id_of(list[i]) == id) {
+      list.EraseAt(i);
+      return CommandStatus::kAccepted;
+    }
+  }
+  return CommandStatus::kUnknownId;
 }
 
 template <typename T>

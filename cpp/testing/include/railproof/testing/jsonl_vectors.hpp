@@ -1,5 +1,5 @@
 // Reading a directory of JSON Lines vector files (<prefix>*.jsonl: a header line, then one
-// vector per line), shared by the moving-block and braking conformance runners. Every
+// vector per line), shared by the conformance runners of br, ra, lc and mb (jsonl_runner.hpp). Every
 // error names the file and line; the capability-specific checks (header fields, step
 // shape) are the callbacks'.
 #pragma once

@@ -16,7 +16,6 @@
 #include <atomic>
 #include <cstddef>
 #include <cstdio>
-#include <filesystem>
 #include <functional>
 #include <optional>
 #include <string>
@@ -137,17 +136,19 @@ inline int Finish(const char* prog, bool ok, const std::string& error, std::size
   return 0;
 }
 
-// Where a vector's test is reported: its GoogleTest name and the file and line of the vector.
+// Where a vector's test is reported: the vector's id, its GoogleTest name and the file and
+// line of the vector.
 struct VectorSite {
+  std::string id;
   std::string test_name;
   std::string file;
   int line = 0;
 };
 
-// The site of vector i of a container whose vectors know their test name, file and line.
+// The site of vector i of a container whose vectors know their id, test name, file and line.
 template <typename Vectors>
 VectorSite SiteOf(const Vectors& vectors, std::size_t i) {
-  return {vectors[i].test_name, vectors[i].file, static_cast<int>(vectors[i].line)};
+  return {vectors[i].id, vectors[i].test_name, vectors[i].file, static_cast<int>(vectors[i].line)};
 }
 
 // What a runner's loader found in the vector directory.
@@ -158,15 +159,49 @@ struct LoadedSet {
   std::size_t files = 0;
 };
 
+// How many vectors a run replayed and how many of them mismatched (the exit protocol).
+struct ReplayCounts {
+  std::atomic<std::size_t> replayed{0};
+  std::atomic<std::size_t> mismatched{0};
+};
+
+// Replays one vector: appends one line per problem (a mismatch names the step, the field,
+// expected and actual); none: the vector passed.
+using ReplayFn = std::function<void(std::vector<std::string>& problems)>;
+
+// The test of one vector: records its id, replays it, counts it (and its mismatch) and
+// reports every problem at the vector's file and line as "vector <id>: <problem>".
+class VectorTest : public testing::Test {
+ public:
+  VectorTest(VectorSite site, ReplayFn replay, ReplayCounts& counts)
+      : site_(std::move(site)), replay_(std::move(replay)), counts_(counts) {}
+  void TestBody() override {
+    counts_.replayed.fetch_add(1);
+    RecordProperty("vector_id", site_.id);
+    std::vector<std::string> problems;
+    replay_(problems);
+    if (!problems.empty()) {
+      counts_.mismatched.fetch_add(1);
+    }
+    for (const std::string& p : problems) {
+      ADD_FAILURE_AT(site_.file.c_str(), site_.line) << "vector " << site_.id << ": " << p;
+    }
+  }
+
+ private:
+  VectorSite site_;
+  ReplayFn replay_;
+  ReplayCounts& counts_;
+};
+
 // The main() of a runner: parses the arguments (prog names it in every line, suite is the
 // GoogleTest suite, description opens --help), loads the vector directory, registers the
-// VectorSet test and one test per vector (site(i) names vector i's test, make_test(i)
-// creates it), prints the load result, runs the tests and applies the exit protocol.
+// VectorSet test and one VectorTest per vector (site(i) names vector i's test, replay(i, ...)
+// replays it), prints the load result, runs the tests and applies the exit protocol.
 inline int RunnerMain(const char* prog, const char* suite, const std::string& description, int argc, char** argv,
                       const std::function<LoadedSet(const std::string& dir)>& load,
                       const std::function<VectorSite(std::size_t)>& site,
-                      const std::function<testing::Test*(std::size_t)>& make_test,
-                      const std::atomic<std::size_t>& mismatched, const std::atomic<std::size_t>& replayed) {
+                      const std::function<void(std::size_t, std::vector<std::string>&)>& replay) {
   const RunnerArgs args = ParseArgsAndInitGoogleTest(prog, description, argc, argv);
   if (args.exit_code >= 0) {
     return args.exit_code;
@@ -177,31 +212,19 @@ inline int RunnerMain(const char* prog, const char* suite, const std::string& de
                         [error = set.error, files = set.files, n]() -> testing::Test* {
                           return new VectorSetTest(error, files, n);
                         });
+  ReplayCounts counts;
   for (std::size_t i = 0; i < n; ++i) {
     const VectorSite at = site(i);
     testing::RegisterTest(suite, at.test_name.c_str(), nullptr, nullptr, at.file.c_str(), at.line,
-                          [make_test, i]() -> testing::Test* { return make_test(i); });
+                          [&replay, &counts, at, i]() -> testing::Test* {
+                            return new VectorTest(
+                                at, [&replay, i](std::vector<std::string>& problems) { replay(i, problems); },
+                                counts);
+                          });
   }
   ReportLoad(prog, set.ok, set.error, n, set.files, args.vectors_dir);
   const int rc_tests = RUN_ALL_TESTS();
-  return Finish(prog, set.ok, set.error, mismatched.load(), replayed.load(), n, rc_tests);
-}
-
-// RunnerMain for a runner whose load(dir, error) fills `vectors` (each knowing its test name,
-// file and line) and the set of `files`, and whose Test is constructed from a vector's index.
-template <typename Test, typename Vectors, typename Files>
-int RunnerMain(const char* prog, const char* suite, const std::string& description, int argc, char** argv,
-               bool (*load)(const std::filesystem::path& dir, std::string& error), const Vectors& vectors,
-               const Files& files, const std::atomic<std::size_t>& mismatched, const std::atomic<std::size_t>& replayed) {
-  return RunnerMain(
-      prog, suite, description, argc, argv,
-      [&](const std::string& dir) {
-        std::string error;
-        const bool ok = load(dir, error);
-        return LoadedSet{ok, error, vectors.size(), files.size()};
-      },
-      [&](std::size_t i) { return SiteOf(vectors, i); }, [](std::size_t i) -> testing::Test* { return new Test(i); },
-      mismatched, replayed);
+  return Finish(prog, set.ok, set.error, counts.mismatched.load(), counts.replayed.load(), n, rc_tests);
 }
 
 }  // namespace railproof::conformance

@@ -2,6 +2,7 @@
 // (spec/design/lc.md §1-§2; model: models/lc.pml):
 //   CrossingData / CrossingExtentOf   crossing geometry [near, far) and design warning time (§1)
 //   ValidateCrossings                 crossing data checks (REQ-LC-001, REQ-LC-008)
+//   FindCrossing                      an entry of a crossing held, by id
 //   EarliestArrivalMs                 earliest arrival of the front at a position (§2,
 //   EarliestArrivalAfterDwellMs       REQ-LC-001, REQ-LC-005); used on board
 //                                     (lc::onboard::CrossingProtection), by the centre
@@ -111,6 +112,19 @@ CrossingDataError CheckCrossing(const CrossingData& c) noexcept;
 // kMaxCrossings).
 // @implements REQ-LC-001 REQ-LC-008
 CrossingDataCheck ValidateCrossings(std::span<const CrossingData> crossings) noexcept;
+
+// The entry of `crossing_id` among `entries` (each holding its crossing as `data`), nullptr
+// if none: the lookup of the on-board crossing function and of the centre scheduler.
+// @implements REQ-LC-002 REQ-LC-003 REQ-LC-008
+template <typename Entry>
+Entry* FindCrossing(std::span<Entry> entries, std::uint32_t crossing_id) noexcept {
+  for (Entry& e : entries) {
+    if (e.data.id == crossing_id) {
+      return &e;
+    }
+  }
+  return nullptr;
+}
 
 // ---- earliest arrival (design §2) --------------------------------------------------------
 

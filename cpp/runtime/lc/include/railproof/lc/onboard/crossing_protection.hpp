@@ -228,6 +228,8 @@ class CrossingProtection {
  private:
   explicit CrossingProtection(const ProtectionConfig& config) noexcept : config_(config) {}
   CrossingEntry* FindMutable(std::uint32_t crossing_id) noexcept;
+  // Holds one more crossing (kApproaching); the caller checked it and the capacity.
+  void Append(const CrossingData& crossing) noexcept;
   void ComputeOutputs() noexcept;
 
   ProtectionConfig config_;
