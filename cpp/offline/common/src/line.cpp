@@ -58,7 +58,8 @@ void ReadIdentified(const JsonNode& parent, std::string_view key, std::string_vi
   std::set<std::string> ids;
   for (const auto& entry : parent.Key(key).Array()) {
     std::string id = ReadId(entry, ids, id_key);
-    read(entry.Labelled(id), std::move(id));
+    const JsonNode labelled = entry.Labelled(id);  // before the id is moved (argument order is unspecified)
+    read(labelled, std::move(id));
   }
 }
 
