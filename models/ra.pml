@@ -24,7 +24,9 @@
  * timeout or a sensor failure, after which the history restarts) withdraws the trust. A
  * start-up without motion ends with the warm-up (the position given at start-up holds);
  * a TG pulse before the trust makes it a start in motion (reason START_IN_MOTION), which,
- * like every other stop, ends only with a balise read once the history is trusted. Model ticks
+ * like every other stop, ends only with a balise read once the history is trusted. While a
+ * stop waits with the history trusted, MODEL_CONFIRM deviations in a row withdraw the trust
+ * (a TG wheel locked through the "standstill" that rolls again shows as such a run). Model ticks
  * are cycles and the abstract margins are fed to the C++ as mm unchanged, which is exact:
  * the machine only compares ages with t_max and takes minima and maxima of the limits.
  *
@@ -141,6 +143,7 @@ byte g_seen;               /* bit k: section kind k under the train in a cycle o
 byte g_hist[2];            /* per candidate: the last CONFIRM "no deviation and speed agrees" bits */
 byte g_mint, g_mmax;       /* scratch: shortest time and largest margin of g_seen */
 byte g_calm;               /* consecutive healthy cycles without a TG pulse since the last stop */
+byte g_srun;               /* consecutive deviations while stopped with the history trusted */
 bit g_trust = 0;           /* g_calm reached MODEL_WARMUP since the last stop (and start-up) */
 bit g_lost;                /* the start-up position is no longer known: a TG pulse or a sensor
                               failure before the start-up stop ended */
@@ -308,6 +311,16 @@ inline cycle() {
      if
      :: mode == M_STOP ->               /* 3. held until trusted and a balise (start-up: trusted) */
         stop = 1; valid = 0;
+        if                              /* a deviation run while waiting withdraws the trust */
+        :: was_trust ->
+           if :: dev -> dcount++ :: else -> dcount = 0 fi;
+#ifndef MUTANT_TRUST_KEPT_ON_DEVIATION
+           if :: dcount >= CONFIRM -> trust = 0; rest = 0; dcount = 0 :: else -> skip fi
+#else
+           skip
+#endif
+        :: else -> skip
+        fi;
         if
 #if defined(MUTANT_RELEASED_WITHOUT_BALISE)
         :: trust ->
@@ -405,7 +418,11 @@ inline ghost() {
    * cycles without a TG pulse since the last stop (or the start) */
   if :: !g_started && (!HEALTHY || (mv && !g_trust)) -> g_lost = 1 :: else -> skip fi;
   if
-  :: !HEALTHY || (mode == M_STOP && was_mode != M_STOP) -> g_calm = 0; g_trust = 0
+  :: was_mode == M_STOP && HEALTHY && g_trust && dev -> g_srun++
+  :: else -> g_srun = 0
+  fi;
+  if
+  :: !HEALTHY || (mode == M_STOP && was_mode != M_STOP) || g_srun >= CONFIRM -> g_calm = 0; g_trust = 0; g_srun = 0
   :: g_trust -> skip
   :: mv -> g_calm = 0
   :: else ->
@@ -498,7 +515,8 @@ inline check() {
   :: else -> skip
   fi;
   /* REQ-RA-015: a valid position only with the history trusted, i.e. after a warm-up of
-   * MODEL_WARMUP healthy cycles without a TG pulse since the last stop; a stop ends without
+   * MODEL_WARMUP healthy cycles without a TG pulse since the last stop (and no run of
+   * MODEL_CONFIRM deviations while stopped since); a stop ends without
    * a balise only at start-up, with no TG pulse and no sensor failure before the trust,
    * and then as soon as the warm-up is complete */
   if
@@ -590,7 +608,9 @@ inline goals() {
   ON(was_mode == M_STOP && HEALTHY && !was_trust && was_rest == MODEL_WARMUP - 1 && mv && rest == 0, 44);
   ON(was_mode == M_STOP && was_reason == R_MAXT && HEALTHY && bal && mode == M_STOP, 45);
   ON(was_mode == M_STOP && was_reason != R_START && !was_trust && trust && bal && mode == M_TG, 46);
-  ON(was_mode == M_STOP && was_reason == R_START && !HEALTHY, 47)
+  ON(was_mode == M_STOP && was_reason == R_START && !HEALTHY, 47);
+  ON(was_mode == M_STOP && was_trust && HEALTHY && dev && mode == M_STOP && !trust, 48);
+  ON(was_mode == M_STOP && was_trust && HEALTHY && was_dcount == CONFIRM - 1 && !dev && trust, 49)
 }
 
 inline clear_cycle() {
@@ -622,7 +642,7 @@ init {
        CHOOSE_MOTION(mv);
        CHOOSE_LIKELY(sa[0]); CHOOSE_LIKELY(sa[1]); CHOOSE_AGE(sage);
 #else
-       if :: HEALTHY && mode != M_STOP -> CHOOSE_BIT(dev) :: else -> skip fi;
+       if :: HEALTHY && (mode != M_STOP || trust) -> CHOOSE_BIT(dev) :: else -> skip fi;
        if :: HEALTHY && !trust -> CHOOSE_BIT(mv) :: else -> skip fi;
        if
        :: HEALTHY && mode == M_COMP ->
@@ -668,7 +688,7 @@ ltl REQ_RA_009_limits { [] !v_limits }
 ltl REQ_RA_010_parallel { [] !v_parallel }
 // @property REQ_RA_012_balise REQ-RA-012 : a balise read in TG odometry with healthy sensors (and the balise that ends a stop) resets the accumulated error in that cycle; there is no reset without a balise and none while compensating
 ltl REQ_RA_012_balise { [] !v_balise }
-// @property REQ_RA_015_startup REQ-RA-015 REQ-RA-007 : the position is valid only while the TG history is trusted, i.e. after a warm-up of MODEL_WARMUP healthy cycles without a TG pulse since the last stop or the start-up; the start-up stop ends without a balise only if no TG pulse and no sensor failure came before the trust, and then in the cycle the warm-up completes; every other stop needs the trust and a balise
+// @property REQ_RA_015_startup REQ-RA-015 REQ-RA-007 : the position is valid only while the TG history is trusted, i.e. after a warm-up of MODEL_WARMUP healthy cycles without a TG pulse since the last stop or the start-up, not withdrawn by MODEL_CONFIRM deviations in a row while stopped; the start-up stop ends without a balise only if no TG pulse and no sensor failure came before the trust, and then in the cycle the warm-up completes; every other stop needs the trust and a balise
 ltl REQ_RA_015_startup { [] !v_startup }
 // @property REQ_RA_013_sensor REQ-RA-013 : an IMU or TG failure gives in the same cycle the stopped state with the failure as reason (IMU checked first), the stop demand and the invalid position, and discards every candidate
 ltl REQ_RA_013_sensor { [] !v_sensor }
@@ -698,6 +718,7 @@ ltl REQ_RA_013_sensor { [] !v_sensor }
 // @mutant MUTANT_BALISE_WITHOUT_WARMUP violates REQ_RA_015_startup : a balise ends a stop before the history is trusted (a timeout or failure in motion)
 // @mutant MUTANT_START_MOVED_IGNORED violates REQ_RA_015_startup : a start in motion ends with the warm-up, without a balise
 // @mutant MUTANT_TRUST_KEPT_ON_STOP violates REQ_RA_015_startup : a timeout keeps the history trusted (no warm-up after a stop)
+// @mutant MUTANT_TRUST_KEPT_ON_DEVIATION violates REQ_RA_015_startup : a deviation run while stopped keeps the history trusted (C++ FAULT_RA_TRUST_KEPT_ON_DEVIATION)
 
 // ---- coverage goals (trap properties): every branch of the cycle, each boundary ----
 // @goal 0 REQ-RA-003 REQ-RA-010 : detection after MODEL_CONFIRM consecutive deviations, both start points compensating
@@ -748,6 +769,8 @@ ltl REQ_RA_013_sensor { [] !v_sensor }
 // @goal 45 REQ-RA-015 REQ-RA-007 : a balise after a timeout before the warm-up at standstill: the stop is held
 // @goal 46 REQ-RA-015 REQ-RA-007 : boundary: the warm-up completes in the cycle of a balise: the stop ends in that cycle
 // @goal 47 REQ-RA-015 REQ-RA-013 : a sensor failure during the start-up
+// @goal 48 REQ-RA-015 REQ-RA-003 : MODEL_CONFIRM deviations while stopped with the history trusted: the trust is withdrawn
+// @goal 49 REQ-RA-015 : boundary: MODEL_CONFIRM - 1 deviations while stopped, then none: the trust holds
 
 #ifdef TRAPS
 #include "ra_goals.pml"

@@ -11,6 +11,7 @@
 //   FAULT_RA_TG_FAILURE_IGNORED    a TG failure does not stop the train
 //   FAULT_RA_WARMUP_COUNTS_MOTION  the warm-up counts cycles with TG pulses (a start in motion is trusted)
 //   FAULT_RA_BALISE_WITHOUT_WARMUP a balise ends a stop before the history is trusted
+//   FAULT_RA_TRUST_KEPT_ON_DEVIATION a deviation run while stopped keeps the history trusted
 #include "railproof/core/seeded_fault.hpp"
 #include "railproof/ra/readhesion_machine.hpp"
 
@@ -95,14 +96,26 @@ MachineError ReadhesionMachine::Step(const Predicates& in) noexcept {
     return MachineError::kNone;
   }
 
+  const bool was_trusted = s_.trusted;
   WarmUp(in.tg_moving);
 
   switch (s_.mode) {
     case Mode::kStopped: {
       // 3. Held until the history is trusted and a balise fix with healthy sensors
       // re-establishes the position; the start-up without motion needs only the warm-up.
+      // While waiting with the history trusted, confirm_cycles deviations in a row withdraw
+      // the trust: a TG wheel that was locked through the "standstill" and rolls again shows
+      // as one (REQ-RA-015).
       s_.stop_demand = true;
       s_.position_valid = false;
+      if (was_trusted) {
+        s_.deviation_count = in.deviation ? static_cast<std::uint8_t>(s_.deviation_count + 1) : 0;
+        if (s_.deviation_count >= cfg_.confirm_cycles && !RAILPROOF_FAULT(FAULT_RA_TRUST_KEPT_ON_DEVIATION)) {
+          s_.trusted = false;
+          s_.rest_cycles = 0;
+          s_.deviation_count = 0;
+        }
+      }
       const bool ends = (s_.trusted || (RAILPROOF_FAULT(FAULT_RA_BALISE_WITHOUT_WARMUP) && in.balise)) &&
                         (in.balise || s_.stop_reason == StopReason::kStartUp);
       if (ends) {

@@ -564,6 +564,29 @@ TEST(OdometryReadhesionMachine, StartInMotionNeedsTheWarmUpAndABalise) {
   EXPECT_TRUE(s.balise_reset);
 }
 
+// While a stop waits for its balise with the history trusted, confirm_cycles deviations in a
+// row withdraw the trust (a TG wheel locked through the "standstill" that rolls again); one
+// fewer does not (boundary). A new warm-up at standstill is needed before the balise.
+// @verifies REQ-RA-015
+TEST(OdometryReadhesionMachine, DeviationRunWhileWaitingWithdrawsTheTrust) {
+  ReadhesionMachine m = Running(Config());
+  Detect(m, kTight, 41);
+  for (int k = 0; k < kWarmup; ++k) Cycle(m, In(false));
+  ASSERT_TRUE(m.state().trusted);
+  for (int k = 1; k < m.config().confirm_cycles; ++k) Cycle(m, In(true));
+  EXPECT_TRUE(Cycle(m, In(false)).trusted);  // confirm_cycles - 1, then none: kept
+  for (int k = 1; k < m.config().confirm_cycles; ++k) EXPECT_TRUE(Cycle(m, In(true)).trusted);
+  const MachineState& s = Cycle(m, In(true));
+  ExpectStopped(s, StopReason::kMaxCompensationTime);
+  EXPECT_FALSE(s.trusted);
+  EXPECT_EQ(s.deviation_count, 0);
+  Predicates bal = In(false);
+  bal.balise = true;
+  ExpectStopped(Cycle(m, bal), StopReason::kMaxCompensationTime);  // trust withdrawn: held
+  for (int k = 0; k < kWarmup; ++k) Cycle(m, In(false));
+  EXPECT_EQ(Cycle(m, bal).mode, Mode::kTg);
+}
+
 // Every stop withdraws the trust: after a timeout a balise counts only after a new warm-up
 // at standstill; a sensor failure during the start-up makes it a failure stop (a balise).
 // @verifies REQ-RA-015
