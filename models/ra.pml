@@ -9,11 +9,24 @@
  * between cycles: the mode (TG odometry, compensating, stopped), the stop reason, the
  * deviation counter, up to two candidates (active, age in cycles, confirmation counter),
  * the episode limits (maximum compensation time t_max in force and margin in force), the
- * stop demand and the position validity. The signal processing (design note §3) is
- * abstracted into the predicates of design note §4, chosen by the environment every
- * cycle: deviation, speed_agrees[0..1], imu_ok, tg_ok, balise, the odometry section under
- * the train and the age of the primary start point (MODEL_START_AGE + 0..MODEL_SEARCH_EXTRA,
- * the look-back plus the start-point search; read only in a detection cycle). Model ticks
+ * stop demand, the position validity and the start-up state (design note §5a: whether the
+ * TG history is trusted, and the run of standstill cycles towards the warm-up). The signal
+ * processing (design note §3) is abstracted into the predicates of design note §4, chosen
+ * by the environment every cycle: deviation, speed_agrees[0..1], imu_ok, tg_ok, balise,
+ * tg_moving (a TG pulse in the cycle), the odometry section under the train and the age of
+ * the primary start point (MODEL_START_AGE + 0..MODEL_SEARCH_EXTRA, the look-back plus the
+ * start-point search; read only in a detection cycle).
+ *
+ * Start-up (REQ-RA-015). The machine starts stopped (reason START_UP): the odometry's
+ * averages and windows are empty, so a slip could not be detected. The TG history becomes
+ * trusted after MODEL_WARMUP consecutive cycles with healthy sensors and no TG pulse (a
+ * warm-up at standstill, so every average starts from a true zero speed); any stop (a
+ * timeout or a sensor failure, after which the history restarts) withdraws the trust. A
+ * start-up without motion ends with the warm-up (the position given at start-up holds);
+ * a TG pulse before the trust makes it a start in motion (reason START_IN_MOTION), which,
+ * like every other stop, ends only with a balise read once the history is trusted. While a
+ * stop waits with the history trusted, MODEL_CONFIRM deviations in a row withdraw the trust
+ * (a TG wheel locked through the "standstill" that rolls again shows as such a run). Model ticks
  * are cycles and the abstract margins are fed to the C++ as mm unchanged, which is exact:
  * the machine only compares ages with t_max and takes minima and maxima of the limits.
  *
@@ -78,6 +91,8 @@
 #define R_MAXT 1
 #define R_IMU 2
 #define R_TG 3
+#define R_START 4
+#define R_MOVED 5
 #define NONE 255
 /* section kinds: limits (T_s cycles, M_s margin units) */
 #define S_LONG 0
@@ -87,19 +102,31 @@
 #define SEC_M(k) ((k) == S_LONG -> MODEL_MARGIN_LONG : ((k) == S_STEEP -> MODEL_MARGIN_STEEP : MODEL_MARGIN_SHORT))
 
 /* ---- machine state (ra::MachineState) ------------------------------------------- */
-byte mode, reason, dcount;
+#ifndef MUTANT_NO_WARMUP
+byte mode = M_STOP, reason = R_START, dcount;
+#else
+byte mode = M_TG, reason = R_NONE, dcount;
+#endif
 bit act[2];                /* candidates: active, age (cycles), confirmation counter */
 byte age[2], conf[2];
 byte tmax, margin;         /* maximum compensation time and margin in force */
+#ifndef MUTANT_NO_WARMUP
+bit stop = 1, valid;
+bit trust;                 /* the TG history is trusted (a warm-up at standstill since the last stop) */
+#else
 bit stop, valid = 1;
+bit trust = 1;
+#endif
+byte rest;                 /* consecutive healthy cycles without a TG pulse while not trusted */
 /* ---- events of the cycle (cleared at its end) ------------------------------------------ */
 bit detected, breset;
 byte adopted = NONE;
 /* ---- inputs of the cycle (cleared at its end) ------------------------------------------ */
-bit dev, sa[2], imu, tg, bal;
+bit dev, sa[2], imu, tg, bal, mv;
 byte sec, sage;
 /* ---- scratch: the state at the start of the cycle, loop index (cleared at its end) ----- */
-byte was_mode, was_reason, was_dcount, was_tmax, was_margin, c;
+byte was_mode, was_reason, was_dcount, was_tmax, was_margin, was_rest, c;
+bit was_trust;
 bit was_act[2];
 byte was_conf[2];
 #ifdef MUTANT_MARGIN_LATE
@@ -115,15 +142,22 @@ byte g_sage, g_since;      /* start-point age at detection, cycles since the det
 byte g_seen;               /* bit k: section kind k under the train in a cycle of the episode */
 byte g_hist[2];            /* per candidate: the last CONFIRM "no deviation and speed agrees" bits */
 byte g_mint, g_mmax;       /* scratch: shortest time and largest margin of g_seen */
+byte g_calm;               /* consecutive healthy cycles without a TG pulse since the last stop */
+byte g_srun;               /* consecutive deviations while stopped with the history trusted */
+bit g_trust = 0;           /* g_calm reached MODEL_WARMUP since the last stop (and start-up) */
+bit g_lost;                /* the start-up position is no longer known: a TG pulse or a sensor
+                              failure before the start-up stop ended */
+bit g_started;             /* the start-up stop has ended once */
 /* ---- ghost: latched property violations ----------------------------------------------- */
 bit v_detect, v_start, v_readh, v_timeout, v_stopped, v_limits, v_parallel, v_balise, v_sensor;
+bit v_startup;
 #ifdef TRAPS
-bit g[48];
+bit g[56];
 byte h_i;
 /* goal flags mark the goals reached in the last cycle only (cleared at the start of each
  * cycle), so that they do not multiply the states of the breadth-first trap searches */
 #define GOAL(k) g[k] = 1
-#define CLEAR_GOALS d_step { for (h_i : 0 .. 47) { g[h_i] = 0 }; h_i = 0 }
+#define CLEAR_GOALS d_step { for (h_i : 0 .. 55) { g[h_i] = 0 }; h_i = 0 }
 #else
 #define CLEAR_GOALS skip
 #define GOAL(k) skip
@@ -161,6 +195,8 @@ byte h_i;
 #define CHOOSE_BALISE(b) if :: b = 1 :: b = 0 :: b = 0 :: b = 0 fi
 #define CHOOSE_LIKELY(b) if :: b = 1 :: b = 1 :: b = 1 :: b = 0 fi
 #define CHOOSE_UNLIKELY(b) if :: b = 1 :: b = 0 :: b = 0 :: b = 0 fi
+/* motion: rare before the trust (the warm-up at standstill completes in most walks) */
+#define CHOOSE_MOTION(b) if :: trust -> CHOOSE_LIKELY(b) :: else -> if :: b = 1 :: b = 0 :: b = 0 :: b = 0 :: b = 0 :: b = 0 :: b = 0 :: b = 0 fi fi
 #else
 #define CHOOSE_OK(b) CHOOSE_BIT(b)
 #define CHOOSE_BALISE(b) CHOOSE_BIT(b)
@@ -173,8 +209,17 @@ inline discard() {
 }
 
 /* step 6: the safe reaction of the timeout */
+inline untrust() {
+#ifndef MUTANT_TRUST_KEPT_ON_STOP
+  trust = 0; rest = 0
+#else
+  skip
+#endif
+}
+
 inline stop_timeout() {
   discard();
+  untrust();
   mode = M_STOP; reason = R_MAXT; stop = 1;
 #ifndef MUTANT_STOP_POSITION_VALID
   valid = 0
@@ -247,18 +292,46 @@ inline cycle() {
      discard();
 #endif
      mode = M_STOP; stop = 1; valid = 0;
-     reason = (!imu -> R_IMU : R_TG)
+     reason = (!imu -> R_IMU : R_TG);
+     trust = 0; rest = 0                /* the history restarts after a rejected cycle */
   :: else ->
+     /* 2a. the warm-up at standstill (REQ-RA-015): healthy cycles without a TG pulse */
      if
-     :: mode == M_STOP ->               /* 3. held until a balise */
-        stop = 1; valid = 0;
+     :: !trust ->
         if
-#ifdef MUTANT_RELEASED_WITHOUT_BALISE
-        :: true ->
-#else
-        :: bal ->
+#ifndef MUTANT_WARMUP_COUNTS_MOTION
+        :: mv -> rest = 0;
+           if :: reason == R_START -> reason = R_MOVED :: else -> skip fi
 #endif
-           mode = M_TG; reason = R_NONE; stop = 0; valid = 1; dcount = 0; breset = 1
+        :: else -> if :: rest < MODEL_WARMUP -> rest++ :: else -> skip fi
+        fi;
+        if :: rest >= MODEL_WARMUP -> trust = 1; rest = 0 :: else -> skip fi
+     :: else -> skip
+     fi;
+     if
+     :: mode == M_STOP ->               /* 3. held until trusted and a balise (start-up: trusted) */
+        stop = 1; valid = 0;
+        if                              /* a deviation run while waiting withdraws the trust */
+        :: was_trust ->
+           if :: dev -> dcount++ :: else -> dcount = 0 fi;
+#ifndef MUTANT_TRUST_KEPT_ON_DEVIATION
+           if :: dcount >= CONFIRM -> trust = 0; rest = 0; dcount = 0 :: else -> skip fi
+#else
+           skip
+#endif
+        :: else -> skip
+        fi;
+        if
+#if defined(MUTANT_RELEASED_WITHOUT_BALISE)
+        :: trust ->
+#elif defined(MUTANT_BALISE_WITHOUT_WARMUP)
+        :: bal || (trust && reason == R_START) ->
+#elif defined(MUTANT_START_MOVED_IGNORED)
+        :: trust && (bal || reason == R_START || reason == R_MOVED) ->
+#else
+        :: trust && (bal || reason == R_START) ->
+#endif
+           mode = M_TG; reason = R_NONE; stop = 0; valid = 1; dcount = 0; breset = bal
         :: else -> skip
         fi
      :: mode == M_TG ->                 /* 4. detection */
@@ -340,6 +413,23 @@ inline cycle() {
 
 /* ---- ghost update from the inputs, then the properties --------------------------------- */
 inline ghost() {
+  /* start-up (REQ-RA-015): the start-up position is lost by a TG pulse before the trust or
+   * by a sensor failure before the start-up stop ended; the trust follows the healthy
+   * cycles without a TG pulse since the last stop (or the start) */
+  if :: !g_started && (!HEALTHY || (mv && !g_trust)) -> g_lost = 1 :: else -> skip fi;
+  if
+  :: was_mode == M_STOP && HEALTHY && g_trust && dev -> g_srun++
+  :: else -> g_srun = 0
+  fi;
+  if
+  :: !HEALTHY || (mode == M_STOP && was_mode != M_STOP) || g_srun >= CONFIRM -> g_calm = 0; g_trust = 0; g_srun = 0
+  :: g_trust -> skip
+  :: mv -> g_calm = 0
+  :: else ->
+     g_calm++;
+     if :: g_calm >= MODEL_WARMUP -> g_trust = 1; g_calm = 0 :: else -> skip fi
+  fi;
+  if :: was_mode == M_STOP && mode != M_STOP -> g_started = 1 :: else -> skip fi;
   /* sections of the episode (the detection cycle and every compensating cycle after it) */
   g_seen = (was_mode == M_COMP -> g_seen : 0) | (1 << sec);
   g_mint = 255; g_mmax = 0;
@@ -412,13 +502,29 @@ inline check() {
   :: else -> skip
   fi;
   /* REQ-RA-007: stop demand and invalid position exactly in the stopped state (with a
-   * reason), held until a balise read with healthy sensors, which re-establishes TG */
+   * reason), held until a balise read with healthy sensors and the history trusted, which
+   * re-establishes TG odometry (the start-up stop: the warm-up, REQ-RA-015); a stop held
+   * with healthy sensors keeps its reason, but for the start-up that saw motion */
   if
   :: stop != (mode == M_STOP) || valid != (mode != M_STOP) -> v_stopped = 1
   :: (mode == M_STOP) != (reason != R_NONE) -> v_stopped = 1
-  :: was_mode == M_STOP && !(HEALTHY && bal) && mode != M_STOP -> v_stopped = 1
-  :: was_mode == M_STOP && HEALTHY && !bal && reason != was_reason -> v_stopped = 1
-  :: was_mode == M_STOP && HEALTHY && bal && mode != M_TG -> v_stopped = 1
+  :: was_mode == M_STOP && mode != M_STOP && !(HEALTHY && mode == M_TG && (bal || was_reason == R_START)) -> v_stopped = 1
+  :: was_mode == M_STOP && mode == M_STOP && HEALTHY && reason != was_reason &&
+     !(was_reason == R_START && reason == R_MOVED && mv) -> v_stopped = 1
+  :: was_mode == M_STOP && HEALTHY && bal && g_trust && mode != M_TG -> v_stopped = 1
+  :: else -> skip
+  fi;
+  /* REQ-RA-015: a valid position only with the history trusted, i.e. after a warm-up of
+   * MODEL_WARMUP healthy cycles without a TG pulse since the last stop (and no run of
+   * MODEL_CONFIRM deviations while stopped since); a stop ends without
+   * a balise only at start-up, with no TG pulse and no sensor failure before the trust,
+   * and then as soon as the warm-up is complete */
+  if
+  :: valid && !g_trust -> v_startup = 1
+  :: trust != g_trust -> v_startup = 1
+  :: was_mode == M_STOP && mode == M_TG && !bal && (g_lost || was_reason != R_START) -> v_startup = 1
+  :: mode == M_STOP && reason == R_START && g_lost -> v_startup = 1
+  :: was_mode == M_STOP && was_reason == R_START && HEALTHY && g_trust && !g_lost && mode != M_TG -> v_startup = 1
   :: else -> skip
   fi;
   /* REQ-RA-009: margin in force >= the margin and t_max in force <= the time of every
@@ -438,7 +544,7 @@ inline check() {
   /* REQ-RA-012: a balise in TG odometry (and the one that ends a stop) resets the
    * accumulated error; no reset without a balise, none while compensating */
   if
-  :: (was_mode == M_TG || was_mode == M_STOP) && HEALTHY && bal && !breset -> v_balise = 1
+  :: (was_mode == M_TG || (was_mode == M_STOP && mode == M_TG)) && HEALTHY && bal && !breset -> v_balise = 1
   :: breset && !(bal && HEALTHY && was_mode != M_COMP) -> v_balise = 1
   :: else -> skip
   fi;
@@ -494,13 +600,24 @@ inline goals() {
   ON(adopted == 0 && NSP == 1, 36);
   ON(COMP_CYCLE && mode == M_STOP && reason == R_MAXT && NSP == 1, 37);
   ON(adopted != NONE && TRUE_AGE(adopted) == tmax, 38);
-  ON(COMP_CYCLE && was_conf[0] > 0 && was_conf[1] > 0 && dev && act[0] && act[1], 39)
+  ON(COMP_CYCLE && was_conf[0] > 0 && was_conf[1] > 0 && dev && act[0] && act[1], 39);
+  ON(was_mode == M_STOP && was_reason == R_START && mode == M_TG, 40);
+  ON(was_reason == R_START && reason == R_MOVED, 41);
+  ON(was_mode == M_STOP && HEALTHY && bal && !trust && mode == M_STOP, 42);
+  ON(was_mode == M_STOP && was_reason == R_MOVED && mode == M_TG, 43);
+  ON(was_mode == M_STOP && HEALTHY && !was_trust && was_rest == MODEL_WARMUP - 1 && mv && rest == 0, 44);
+  ON(was_mode == M_STOP && was_reason == R_MAXT && HEALTHY && bal && mode == M_STOP, 45);
+  ON(was_mode == M_STOP && was_reason != R_START && !was_trust && trust && bal && mode == M_TG, 46);
+  ON(was_mode == M_STOP && was_reason == R_START && !HEALTHY, 47);
+  ON(was_mode == M_STOP && was_trust && HEALTHY && dev && mode == M_STOP && !trust, 48);
+  ON(was_mode == M_STOP && was_trust && HEALTHY && was_dcount == CONFIRM - 1 && !dev && trust, 49)
 }
 
 inline clear_cycle() {
-  dev = 0; sa[0] = 0; sa[1] = 0; imu = 0; tg = 0; bal = 0; sec = 0; sage = 0;
+  dev = 0; sa[0] = 0; sa[1] = 0; imu = 0; tg = 0; bal = 0; mv = 0; sec = 0; sage = 0;
   detected = 0; breset = 0; adopted = NONE;
-  was_mode = 0; was_reason = 0; was_dcount = 0; was_tmax = 0; was_margin = 0; c = 0;
+  was_mode = 0; was_reason = 0; was_dcount = 0; was_tmax = 0; was_margin = 0; was_rest = 0; c = 0;
+  was_trust = 0;
   was_act[0] = 0; was_act[1] = 0; was_conf[0] = 0; was_conf[1] = 0;
   g_mint = 0; g_mmax = 0;
   /* ghosts outside their use: the run outside TG odometry, the episode outside compensation */
@@ -522,9 +639,11 @@ init {
        CHOOSE_SEC(sec); CHOOSE_OK(imu); CHOOSE_OK(tg); CHOOSE_BALISE(bal);
 #ifdef WALK
        if :: mode == M_COMP -> CHOOSE_UNLIKELY(dev) :: else -> CHOOSE_LIKELY(dev) fi;
+       CHOOSE_MOTION(mv);
        CHOOSE_LIKELY(sa[0]); CHOOSE_LIKELY(sa[1]); CHOOSE_AGE(sage);
 #else
-       if :: HEALTHY && mode != M_STOP -> CHOOSE_BIT(dev) :: else -> skip fi;
+       if :: HEALTHY && (mode != M_STOP || trust) -> CHOOSE_BIT(dev) :: else -> skip fi;
+       if :: HEALTHY && !trust -> CHOOSE_BIT(mv) :: else -> skip fi;
        if
        :: HEALTHY && mode == M_COMP ->
           CHOOSE_BIT(sa[0]);
@@ -534,15 +653,16 @@ init {
        if :: HEALTHY && mode == M_TG && dev -> CHOOSE_AGE(sage) :: else -> sage = MODEL_START_AGE fi;
 #endif
        d_step {
-         printf("@IN cycle dev=%d sa0=%d sa1=%d imu=%d tg=%d bal=%d sec=%d age=%d\n",
-                dev, sa[0], sa[1], imu, tg, bal, sec, sage);
+         printf("@IN cycle dev=%d sa0=%d sa1=%d imu=%d tg=%d bal=%d mv=%d sec=%d age=%d\n",
+                dev, sa[0], sa[1], imu, tg, bal, mv, sec, sage);
          was_mode = mode; was_reason = reason; was_dcount = dcount; was_tmax = tmax;
+         was_rest = rest; was_trust = trust;
          was_margin = margin; was_act[0] = act[0]; was_act[1] = act[1];
          was_conf[0] = conf[0]; was_conf[1] = conf[1];
          cycle();
-         printf("@OUT mode=%d reason=%d dcount=%d a0=%d t0=%d c0=%d a1=%d t1=%d c1=%d tmax=%d margin=%d stop=%d valid=%d det=%d adopted=%d breset=%d\n",
+         printf("@OUT mode=%d reason=%d dcount=%d a0=%d t0=%d c0=%d a1=%d t1=%d c1=%d tmax=%d margin=%d stop=%d valid=%d det=%d adopted=%d breset=%d trust=%d rest=%d\n",
                 mode, reason, dcount, act[0], age[0], conf[0], act[1], age[1], conf[1], tmax, margin,
-                stop, valid, detected, adopted, breset);
+                stop, valid, detected, adopted, breset, trust, rest);
          ghost();
          check();
          goals();
@@ -568,6 +688,8 @@ ltl REQ_RA_009_limits { [] !v_limits }
 ltl REQ_RA_010_parallel { [] !v_parallel }
 // @property REQ_RA_012_balise REQ-RA-012 : a balise read in TG odometry with healthy sensors (and the balise that ends a stop) resets the accumulated error in that cycle; there is no reset without a balise and none while compensating
 ltl REQ_RA_012_balise { [] !v_balise }
+// @property REQ_RA_015_startup REQ-RA-015 REQ-RA-007 : the position is valid only while the TG history is trusted, i.e. after a warm-up of MODEL_WARMUP healthy cycles without a TG pulse since the last stop or the start-up, not withdrawn by MODEL_CONFIRM deviations in a row while stopped; the start-up stop ends without a balise only if no TG pulse and no sensor failure came before the trust, and then in the cycle the warm-up completes; every other stop needs the trust and a balise
+ltl REQ_RA_015_startup { [] !v_startup }
 // @property REQ_RA_013_sensor REQ-RA-013 : an IMU or TG failure gives in the same cycle the stopped state with the failure as reason (IMU checked first), the stop demand and the invalid position, and discards every candidate
 ltl REQ_RA_013_sensor { [] !v_sensor }
 
@@ -591,6 +713,12 @@ ltl REQ_RA_013_sensor { [] !v_sensor }
 // @mutant MUTANT_DEVIATION_IGNORED violates REQ_RA_006_readhesion : the deviation condition of the re-adhesion judgement is ignored
 // @mutant MUTANT_OTHER_KEPT violates REQ_RA_010_parallel : the candidate not adopted stays active after the adoption
 // @mutant MUTANT_FAILURE_KEEPS_CANDIDATES violates REQ_RA_013_sensor : a sensor failure stops the train but keeps the candidates
+// @mutant MUTANT_NO_WARMUP violates REQ_RA_015_startup : the odometry starts in TG odometry with a valid position, without a warm-up (the former start-up)
+// @mutant MUTANT_WARMUP_COUNTS_MOTION violates REQ_RA_015_startup : the warm-up counts cycles with TG pulses (a start in motion is trusted)
+// @mutant MUTANT_BALISE_WITHOUT_WARMUP violates REQ_RA_015_startup : a balise ends a stop before the history is trusted (a timeout or failure in motion)
+// @mutant MUTANT_START_MOVED_IGNORED violates REQ_RA_015_startup : a start in motion ends with the warm-up, without a balise
+// @mutant MUTANT_TRUST_KEPT_ON_STOP violates REQ_RA_015_startup : a timeout keeps the history trusted (no warm-up after a stop)
+// @mutant MUTANT_TRUST_KEPT_ON_DEVIATION violates REQ_RA_015_startup : a deviation run while stopped keeps the history trusted (C++ FAULT_RA_TRUST_KEPT_ON_DEVIATION)
 
 // ---- coverage goals (trap properties): every branch of the cycle, each boundary ----
 // @goal 0 REQ-RA-003 REQ-RA-010 : detection after MODEL_CONFIRM consecutive deviations, both start points compensating
@@ -633,6 +761,16 @@ ltl REQ_RA_013_sensor { [] !v_sensor }
 // @goal 37 REQ-RA-007 : one start point: the single candidate times out: stop demand [config ONE_START]
 // @goal 38 REQ-RA-006 REQ-RA-007 : boundary: re-adhesion in the cycle the adopted candidate reaches exactly t_max
 // @goal 39 REQ-RA-006 : a deviation while compensating restarts the confirmation of both start points
+// @goal 40 REQ-RA-015 : start-up at standstill: the warm-up completes, TG odometry with the start-up position (no balise needed)
+// @goal 41 REQ-RA-015 : a TG pulse during the start-up: a start in motion (reason START_IN_MOTION)
+// @goal 42 REQ-RA-015 REQ-RA-007 : a balise while stopped before the history is trusted: the stop is held
+// @goal 43 REQ-RA-015 : a start in motion ends after a warm-up at standstill and a balise
+// @goal 44 REQ-RA-015 : boundary: MODEL_WARMUP - 1 cycles at standstill, then a TG pulse: the warm-up restarts
+// @goal 45 REQ-RA-015 REQ-RA-007 : a balise after a timeout before the warm-up at standstill: the stop is held
+// @goal 46 REQ-RA-015 REQ-RA-007 : boundary: the warm-up completes in the cycle of a balise: the stop ends in that cycle
+// @goal 47 REQ-RA-015 REQ-RA-013 : a sensor failure during the start-up
+// @goal 48 REQ-RA-015 REQ-RA-003 : MODEL_CONFIRM deviations while stopped with the history trusted: the trust is withdrawn
+// @goal 49 REQ-RA-015 : boundary: MODEL_CONFIRM - 1 deviations while stopped, then none: the trust holds
 
 #ifdef TRAPS
 #include "ra_goals.pml"

@@ -20,9 +20,9 @@ SCHEMA = REPO / "spec" / "schemas" / "vectors_ra.schema.json"
 
 # the seeded C++ faults of cpp/runtime/ra/src/readhesion_machine.cpp, each mirrored by a mutant
 CPP_FAULTS = ["TIMEOUT_OFF_BY_ONE", "CONFIRM_TWO", "SPEED_IGNORED", "EPISODE_RELAXES", "LAST_CANDIDATE_WINS",
-              "TG_FAILURE_IGNORED"]
+              "TG_FAILURE_IGNORED", "TRUST_KEPT_ON_DEVIATION"]
 BOUNDS = {"confirm": 3, "start_age": 2, "search_extra": 1, "spacing": 2, "tmax_long": 9, "tmax_short": 6,
-          "margin_long": 2, "margin_steep": 3, "margin_short": 1, "cycles": 16}
+          "margin_long": 2, "margin_steep": 3, "margin_short": 1, "warmup": 2, "cycles": 16}
 
 
 def test_annotations_of_the_readhesion_model():
@@ -30,13 +30,13 @@ def test_annotations_of_the_readhesion_model():
     props = {p.name: p for p in ann.properties}
     assert set(props) == {"REQ_RA_003_detection", "REQ_RA_004_start_point", "REQ_RA_006_readhesion", "REQ_RA_007_timeout",
                           "REQ_RA_007_stopped", "REQ_RA_009_limits", "REQ_RA_010_parallel", "REQ_RA_012_balise",
-                          "REQ_RA_013_sensor"}
+                          "REQ_RA_013_sensor", "REQ_RA_015_startup"}
     for name, p in props.items():  # named by the requirement it verifies, default configuration
         assert name[:10].replace("_", "-") in p.requirements
         assert p.config is None
     covered = {r for p in ann.properties for r in p.requirements}
     assert covered == {"REQ-RA-003", "REQ-RA-004", "REQ-RA-006", "REQ-RA-007", "REQ-RA-009", "REQ-RA-010", "REQ-RA-012",
-                       "REQ-RA-013"}
+                       "REQ-RA-013", "REQ-RA-015"}
     # the one-start-point configuration: a variant, so every property is verified in it too
     assert [(v.define, v.parameter, v.bound) for v in ann.variants] == [("ONE_START", "start_points", "1")]
     assert [c.define for c in PART.configurations] == [None, "ONE_START"]
@@ -51,11 +51,11 @@ def test_annotations_of_the_readhesion_model():
     assert {g.config for g in ann.goals} == {None, "ONE_START"}
 
 
-def _cycle(dev=0, sa=(0, 0), imu=1, tg=1, bal=0, sec=0, age=2, **out):
+def _cycle(dev=0, sa=(0, 0), imu=1, tg=1, bal=0, mv=0, sec=0, age=2, **out):
     o = {"mode": 0, "reason": 0, "dcount": 0, "a0": 0, "t0": 0, "c0": 0, "a1": 0, "t1": 0, "c1": 0, "tmax": 9,
-         "margin": 2, "stop": 0, "valid": 1, "det": 0, "adopted": 255, "breset": 0}
+         "margin": 2, "stop": 0, "valid": 1, "det": 0, "adopted": 255, "breset": 0, "trust": 1, "rest": 0}
     o.update(out)
-    return [f"  @IN cycle dev={dev} sa0={sa[0]} sa1={sa[1]} imu={imu} tg={tg} bal={bal} sec={sec} age={age}",
+    return [f"  @IN cycle dev={dev} sa0={sa[0]} sa1={sa[1]} imu={imu} tg={tg} bal={bal} mv={mv} sec={sec} age={age}",
             "  @OUT " + " ".join(f"{k}={v}" for k, v in o.items())]
 
 
@@ -64,29 +64,31 @@ def test_parse_events_and_steps():
         ["spin: some unrelated line"]
         + _cycle(dev=1, sec=1, age=3, mode=1, a0=1, t0=3, a1=1, t1=5, margin=3, det=1, breset=0)
         + _cycle(sa=(1, 0), sec=2, mode=0, tmax=6, margin=3, adopted=0)
-        + _cycle(imu=0, tg=0, bal=1, mode=2, reason=2, tmax=9, stop=1, valid=0)
-        + ["  @IN cycle dev=0 sa0=0 sa1=0 imu=1 tg=1 bal=0 sec=0 age=2"])  # cut off by the end of a trail
+        + _cycle(imu=0, tg=0, bal=1, mode=2, reason=2, tmax=9, stop=1, valid=0, trust=0)
+        + _cycle(mv=1, mode=2, reason=5, stop=1, valid=0, trust=0)
+        + ["  @IN cycle dev=0 sa0=0 sa1=0 imu=1 tg=1 bal=0 mv=0 sec=0 age=2"])  # cut off by the end of a trail
     ev = PART.parse_events(text)
-    assert len(ev) == 3
-    assert ev[0][0] == {"dev": True, "sa": [False, False], "imu": True, "tg": True, "bal": False, "sec": 1,
-                        "age": 3}
+    assert len(ev) == 4
+    assert ev[0][0] == {"dev": True, "sa": [False, False], "imu": True, "tg": True, "bal": False, "mv": False,
+                        "sec": 1, "age": 3}
     steps = PART.to_steps(ev, BOUNDS, None)
     assert steps[0] == {
         "in": {"deviation": True, "speed_agrees": [False, False], "imu_ok": True, "tg_ok": True, "balise": False,
-               "section": {"kind": "STEEP", "max_compensation_cycles": 9, "margin_mm": 3},
+               "tg_moving": False, "section": {"kind": "STEEP", "max_compensation_cycles": 9, "margin_mm": 3},
                "start_age_cycles": 3},
         "out": {"mode": "COMPENSATING", "stop_reason": "NONE", "deviation_count": 0,
                 "candidates": [{"active": True, "age_cycles": 3, "confirm": 0},
                                {"active": True, "age_cycles": 5, "confirm": 0}],
                 "max_compensation_cycles": 9, "margin_mm": 3, "stop_demand": False, "position_valid": True,
-                "detected": True, "adopted": None, "balise_reset": False}}
+                "trusted": True, "rest_cycles": 0, "detected": True, "adopted": None, "balise_reset": False}}
     assert steps[1]["in"]["section"] == {"kind": "TIGHT", "max_compensation_cycles": 6, "margin_mm": 1}
     assert steps[1]["in"]["speed_agrees"] == [True, False]
     assert steps[1]["out"]["adopted"] == 0 and steps[1]["out"]["mode"] == "TG"
     assert steps[2]["out"]["stop_reason"] == "IMU_FAILURE" and steps[2]["out"]["stop_demand"]
-    assert not steps[2]["in"]["imu_ok"] and steps[2]["in"]["balise"]
+    assert not steps[2]["in"]["imu_ok"] and steps[2]["in"]["balise"] and not steps[2]["out"]["trusted"]
+    assert steps[3]["in"]["tg_moving"] and steps[3]["out"]["stop_reason"] == "START_IN_MOTION"
     assert PART.observed_requirements(steps) == {"REQ-RA-003", "REQ-RA-004", "REQ-RA-006", "REQ-RA-009", "REQ-RA-010",
-                                                        "REQ-RA-013"}
+                                                        "REQ-RA-013", "REQ-RA-015"}
     assert PART.observed_requirements([]) == set()
 
 
@@ -117,6 +119,7 @@ def test_header_records_the_machine_configuration():
     assert h["configuration"] == "default" and h1["configuration"] == "ONE_START"
     assert h["parameters"]["start_points"] == 2 and h1["parameters"]["start_points"] == 1
     assert h["parameters"]["confirm_cycles"] == 3 and h["parameters"]["spacing_cycles"] == 2
+    assert h["parameters"]["warmup_cycles"] == 2
     assert h["parameters"]["start_age_cycles"] == [2, 3]
     assert h["units"] == ra.UNITS == "model ticks = cycles, model margin units = mm"
     assert [s["kind"] for s in h["parameters"]["sections"]] == ra.SECTIONS

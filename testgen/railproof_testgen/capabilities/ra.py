@@ -21,23 +21,23 @@ from ..vectors import Configuration, Part, model_bounds, model_lines
 
 # ra::Mode and ra::StopReason in order, named as their ToString
 MODES = ["TG", "COMPENSATING", "STOPPED"]
-REASONS = ["NONE", "MAX_COMPENSATION_TIME", "IMU_FAILURE", "TG_FAILURE"]
+REASONS = ["NONE", "MAX_COMPENSATION_TIME", "IMU_FAILURE", "TG_FAILURE", "START_UP", "START_IN_MOTION"]
 # the model's section kinds in order (S_LONG, S_STEEP, S_SHORT)
 SECTIONS = ["NORMAL", "STEEP", "TIGHT"]
 NO_CANDIDATE = 255
 UNITS = "model ticks = cycles, model margin units = mm"
 BOUNDS = ("confirm", "start_age", "search_extra", "spacing", "tmax_long", "tmax_short", "margin_long",
-          "margin_steep", "margin_short", "cycles")
+          "margin_steep", "margin_short", "warmup", "cycles")
 # start points of the machine in each configuration
 START_POINTS = {None: 2, "ONE_START": 1}
 
-_RX_IN = re.compile(r"@IN cycle dev=([01]) sa0=([01]) sa1=([01]) imu=([01]) tg=([01]) bal=([01]) "
+_RX_IN = re.compile(r"@IN cycle dev=([01]) sa0=([01]) sa1=([01]) imu=([01]) tg=([01]) bal=([01]) mv=([01]) "
                     r"sec=(\d+) age=(\d+)")
 _RX_OUT = re.compile(r"@OUT mode=(\d+) reason=(\d+) dcount=(\d+) a0=([01]) t0=(\d+) c0=(\d+) "
                      r"a1=([01]) t1=(\d+) c1=(\d+) tmax=(\d+) margin=(\d+) stop=([01]) valid=([01]) "
-                     r"det=([01]) adopted=(\d+) breset=([01])")
+                     r"det=([01]) adopted=(\d+) breset=([01]) trust=([01]) rest=(\d+)")
 _OUT_KEYS = ("mode", "reason", "dcount", "a0", "t0", "c0", "a1", "t1", "c1", "tmax", "margin", "stop",
-             "valid", "det", "adopted", "breset")
+             "valid", "det", "adopted", "breset", "trust", "rest")
 
 
 def section_limits(b: dict):
@@ -63,7 +63,8 @@ class ReAdhesion(Part):
         for kind, m, line in model_lines(text, {"in": _RX_IN, "out": _RX_OUT}):
             if kind == "in":
                 pending = {"dev": m[1] == "1", "sa": [m[2] == "1", m[3] == "1"], "imu": m[4] == "1",
-                           "tg": m[5] == "1", "bal": m[6] == "1", "sec": int(m[7]), "age": int(m[8])}
+                           "tg": m[5] == "1", "bal": m[6] == "1", "mv": m[7] == "1", "sec": int(m[8]),
+                           "age": int(m[9])}
             elif pending is None:
                 raise PipelineError(f"@OUT without its @IN cycle: {line.strip()}")
             else:
@@ -83,7 +84,7 @@ class ReAdhesion(Part):
             t_s, m_s = limits[i["sec"]]
             steps.append({
                 "in": {"deviation": i["dev"], "speed_agrees": list(i["sa"]), "imu_ok": i["imu"], "tg_ok": i["tg"],
-                       "balise": i["bal"],
+                       "balise": i["bal"], "tg_moving": i["mv"],
                        "section": {"kind": SECTIONS[i["sec"]], "max_compensation_cycles": t_s, "margin_mm": m_s},
                        "start_age_cycles": i["age"]},
                 "out": {"mode": MODES[o["mode"]], "stop_reason": REASONS[o["reason"]],
@@ -92,6 +93,7 @@ class ReAdhesion(Part):
                                        for c in (0, 1)],
                         "max_compensation_cycles": o["tmax"], "margin_mm": o["margin"],
                         "stop_demand": bool(o["stop"]), "position_valid": bool(o["valid"]),
+                        "trusted": bool(o["trust"]), "rest_cycles": o["rest"],
                         "detected": bool(o["det"]),
                         "adopted": None if o["adopted"] == NO_CANDIDATE else o["adopted"],
                         "balise_reset": bool(o["breset"])}})
@@ -117,6 +119,8 @@ class ReAdhesion(Part):
                 reqs.add("REQ-RA-013")
             if o["balise_reset"]:
                 reqs.add("REQ-RA-012")
+            if o["stop_reason"] in ("START_UP", "START_IN_MOTION"):
+                reqs.add("REQ-RA-015")
         return reqs
 
     def header(self, target, define):
@@ -128,6 +132,7 @@ class ReAdhesion(Part):
             parameters={
                 # ra::MachineConfig of the replay
                 "confirm_cycles": b["confirm"], "start_points": START_POINTS[define], "spacing_cycles": b["spacing"],
+                "warmup_cycles": b["warmup"],
                 # the environment of the model (documentation of the vectors' range)
                 "start_age_cycles": [b["start_age"], b["start_age"] + b["search_extra"]],
                 "sections": [{"kind": k, "max_compensation_cycles": t, "margin_mm": m}

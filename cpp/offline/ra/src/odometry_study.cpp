@@ -16,7 +16,14 @@ namespace railproof::ra::analysis {
 namespace rp = params::ra;
 using offline::InputError;
 
-VehicleAccelBounds D1VehicleBounds() noexcept { return VehicleAccelBounds{0.58, 0.92, 0.97, 1.4}; }
+// D1's figures in km/h/s (spec/parameters/ra.yaml former_*, 0.1 km/h/s) in m/s^2.
+VehicleAccelBounds D1VehicleBounds() noexcept {
+  constexpr double kKmhSx10 = 1.0 / 36.0;  // 0.1 km/h/s in m/s^2
+  return VehicleAccelBounds{static_cast<double>(rp::former_accel_min_kmh_s_x10) * kKmhSx10,
+                            static_cast<double>(rp::former_accel_max_kmh_s_x10) * kKmhSx10,
+                            static_cast<double>(rp::former_decel_min_kmh_s_x10) * kKmhSx10,
+                            static_cast<double>(rp::former_decel_max_kmh_s_x10) * kKmhSx10};
+}
 
 double GravityMS2() noexcept { return static_cast<double>(rp::gravity_mm_s2) / 1000.0; }
 double RateErrorFullDegS() noexcept { return static_cast<double>(rp::imu_rate_error_full_udeg_s) / 1e6; }
@@ -40,7 +47,7 @@ BaselineExtension BaselineExtensionM(double t_s, double gradient_permille, const
   const double gg = GravityMS2() * std::abs(gradient_permille) / 1000.0;
   BaselineExtension e;
   e.slip_front_accel = b.accel_max + gg;
-  e.slip_rear_accel = b.accel_min - gg;
+  e.slip_rear_accel = -gg;  // the minimum acceleration including coasting: coasting (D1 §3.4.3)
   e.slide_front_accel = gg;
   e.slide_rear_accel = -(b.decel_max + gg);
   const double half_t2 = 0.5 * t_s * t_s;

@@ -235,6 +235,60 @@ void CheckEnvelopeOf(ScenarioStudy& st, const StudyRun& r) {
   st.checks.push_back(chk);
 }
 
+// The start-up (REQ-RA-015), from the truth: no valid position before the end of the warm-up
+// at standstill (moving averages plus the TG window). A train that stood through it (moved,
+// and turned its TG wheel, less than one TG pulse) has its position from the warm-up's last
+// cycle on; a train that moved or spun its TG wheel before (a start in motion) has none until
+// it has stood for a warm-up and then read a balise, and its stop reason is START_IN_MOTION
+// meanwhile. (A train that moved with its TG wheel locked through the warm-up, which ASM-031
+// excludes, fails the check.)
+void CheckStartUp(ScenarioStudy& st, const StudyRun& r) {
+  constexpr std::size_t kWarmup = static_cast<std::size_t>((rp::moving_average_ms + rp::tg_window_ms) / rp::cycle_ms);
+  ScenarioCheck chk{"start_up_" + r.label, false, ""};
+  const auto& truth = st.sim.truth;
+  const auto& cy = r.cycles;
+  std::size_t first_valid = cy.size();
+  for (std::size_t k = 0; k < cy.size(); ++k) {
+    if (cy[k].out.position_valid) {
+      first_valid = k;
+      break;
+    }
+  }
+  if (cy.size() < kWarmup || truth.size() != cy.size()) {
+    chk.detail = "run shorter than the warm-up";
+  } else if (truth[kWarmup - 1].distance_m < st.sim.pulse_length_m &&
+             truth[kWarmup - 1].tg_distance_m - truth[0].tg_distance_m < st.sim.pulse_length_m) {
+    // at standstill through the warm-up
+    chk.ok = first_valid == kWarmup - 1 && cy[0].out.stop_reason == StopReason::kStartUp;
+    chk.detail = "at standstill through the warm-up; first valid position at " +
+                 (first_valid < cy.size() ? std::to_string(cy[first_valid].time_ms) + " ms" : std::string("none")) +
+                 " (expected at the warm-up's end, " + std::to_string(cy[kWarmup - 1].time_ms) + " ms)";
+  } else {
+    // a start in motion: valid only at a balise after kWarmup cycles at standstill
+    bool in_motion_reason = false;
+    std::size_t rest = 0;
+    bool rested = false;
+    for (std::size_t k = 0; k < first_valid; ++k) {
+      in_motion_reason = in_motion_reason || cy[k].out.stop_reason == StopReason::kStartInMotion;
+      rest = truth[k].speed_mps == 0.0 || (k > 0 && truth[k].distance_m - truth[k - 1].distance_m < 1e-6) ? rest + 1 : 0;
+      rested = rested || rest >= kWarmup;
+    }
+    chk.ok = in_motion_reason && (first_valid == cy.size() || (rested && cy[first_valid].balise));
+    chk.detail = std::string("a start in motion (the train moved ") + Fmt("%.2f", truth[kWarmup - 1].distance_m) +
+                 " m, its TG wheel " + Fmt("%.2f", truth[kWarmup - 1].tg_distance_m - truth[0].tg_distance_m) +
+                 " m during the warm-up): " + (in_motion_reason ? "START_IN_MOTION" : "no START_IN_MOTION") +
+                 ", first valid position " +
+                 (first_valid < cy.size() ? "at " + std::to_string(cy[first_valid].time_ms) + " ms" +
+                                                (cy[first_valid].balise ? " (balise)" : " (no balise)") +
+                                                (rested ? ", after a standstill warm-up" : ", without a standstill warm-up")
+                                          : std::string("never"));
+  }
+  if (!chk.ok) {
+    st.failures.push_back(st.scenario.name + ": run " + r.label + ": start-up: " + chk.detail);
+  }
+  st.checks.push_back(chk);
+}
+
 void CheckSafeReaction(ScenarioStudy& st) {
   const StudyRun& r = st.primary;
   if (!st.scenario.expect_safe_reaction) {
@@ -400,6 +454,8 @@ ScenarioStudy StudyScenario(const ra::analysis::WheelRailScenario& sc, const ra:
   CheckBound(st);
   CheckEnvelopeOf(st, st.primary);
   CheckEnvelopeOf(st, st.single);
+  CheckStartUp(st, st.primary);
+  CheckStartUp(st, st.single);
   CheckSafeReaction(st);
   CheckSensorFaults(st);
   CheckNoSpuriousDetection(st);

@@ -37,6 +37,20 @@ double AdhesionCoefficient(double creep, double v_mps, double rail_factor, const
 
 const char* ToString(SlipKind k) { return k == SlipKind::kSlip ? "slip" : "slide"; }
 
+const char* ToString(ScenarioStart s) {
+  switch (s) {
+    case ScenarioStart::kAtRest: return "at_rest";
+    case ScenarioStart::kLeadIn: return "lead_in";
+    case ScenarioStart::kInMotion: return "in_motion";
+  }
+  return "unknown";
+}
+
+// Ramp from rest at accel to the speed, then held for hold_s.
+double LeadInDistanceM(const LeadInSpec& lead, double speed_mps) {
+  return speed_mps * speed_mps / (2.0 * lead.accel_mps2) + speed_mps * lead.hold_s;
+}
+
 const char* ToString(SensorFaultKind k) {
   switch (k) {
     case SensorFaultKind::kTgDropout: return "tg_dropout";

@@ -129,6 +129,8 @@ nlohmann::ordered_json WheelRailJson(const WheelRailScenario& sc, const WheelRai
            {"expect_safe_reaction", sc.expect_safe_reaction},
            {"seed", sc.seed},
            {"duration_s", run.simulated_s},
+           {"start", ToString(sc.start)},
+           {"lead_in_ms", run.lead_in_ms},
            {"wheel_diameter_m", sc.vehicle.wheel_diameter_m},
            {"tg_axle", sc.tg.axle},
            {"tg_teeth", sc.tg.teeth},

@@ -293,6 +293,43 @@ void ParseTg(const JsonNode& n, WheelRailScenario& sc) {
   sc.tg.calibration_error_ppm = RangedKey(n, "calibration_error_ppm", 0.0, -20000.0, 20000.0);
 }
 
+// "start" (REQ-RA-015): at_rest needs initial speed 0, lead_in and in_motion a speed above 0;
+// a lead-in extends the first gradient backwards over its length and must not cross an
+// adhesion zone that is there without a time window (the lead-in is not part of the test).
+void ParseStart(const JsonNode& root, WheelRailScenario& sc) {
+  const double v0 = sc.initial_speed_kmh / 3.6;
+  sc.start = v0 > 0.0 ? ScenarioStart::kLeadIn : ScenarioStart::kAtRest;
+  const auto n = root.OptKey("start");
+  if (n) {
+    const std::string t = n->String();
+    bool known = false;
+    for (const auto k : {ScenarioStart::kAtRest, ScenarioStart::kLeadIn, ScenarioStart::kInMotion}) {
+      if (t == ToString(k)) {
+        sc.start = k;
+        known = true;
+      }
+    }
+    if (!known) n->Fail("unknown start '" + t + "' (at_rest, lead_in, in_motion)");
+    if ((sc.start == ScenarioStart::kAtRest) != (v0 == 0.0)) {
+      n->Fail("start '" + t + "' with initial_speed_kmh " + Fmt(sc.initial_speed_kmh) +
+              " (at_rest is a start at speed 0, lead_in and in_motion at a speed above 0)");
+    }
+  } else if (v0 > 0.0) {
+    root.Fail("missing key 'start' (a run that begins in motion: lead_in or in_motion)");
+  }
+  if (sc.start != ScenarioStart::kLeadIn) return;
+  const double from = sc.initial_front_m - LeadInDistanceM(sc.lead_in, v0);
+  for (const AdhesionZone& z : sc.rail.zones) {
+    if (z.begin_m < sc.initial_front_m && z.end_m > from - sc.vehicle.length_m && !z.from_s) {
+      n->Fail("lead_in: the lead-in from " + Fmt(from) + " m crosses the adhesion zone [" + Fmt(z.begin_m) + ", " +
+              Fmt(z.end_m) + ") m, which has no time window");
+    }
+  }
+  const double begin = std::min(sc.vertical.begin_m, from - sc.vehicle.length_m - 20.0);
+  sc.vertical.begin_m = begin;
+  sc.vertical.gradients.front().from_m = begin;
+}
+
 SensorFaultKind FaultKind(const JsonNode& n) {
   const std::string t = n.String();
   for (const auto k : {SensorFaultKind::kTgDropout, SensorFaultKind::kTgStuck, SensorFaultKind::kTgBurst,
@@ -438,6 +475,7 @@ WheelRailScenario ParseWheelRailScenario(std::string_view text, const std::strin
             " m) must stand inside the vertical alignment with 10 m behind its rear");
   }
   sc.initial_speed_kmh = RangedKey(root, "initial_speed_kmh", 0.0, 0.0, sc.vehicle.max_speed_kmh);
+  ParseStart(root, sc);
   if (const auto b = root.OptKey("balises")) {
     for (const auto& e : b->Array()) {
       BalisePoint p;

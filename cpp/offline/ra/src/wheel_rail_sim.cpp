@@ -190,6 +190,7 @@ class Simulator {
     world_.SetAllowSleeping(false);
     world_.SetContinuousPhysics(false);
     world_.SetContactListener(&listener_);
+    leading_ = sc_.start == ScenarioStart::kLeadIn;
     InitSensors();
     BuildVehicle();
   }
@@ -219,8 +220,10 @@ class Simulator {
 
   void BuildVehicle() {
     const auto& v = sc_.vehicle;
-    const double front = sc_.initial_front_m;
-    const double v0 = sc_.initial_speed_kmh / 3.6;
+    // a lead-in starts at rest so far back that its speed ramp and hold end at the front
+    const double front = leading_ ? sc_.initial_front_m - LeadInDistanceM(sc_.lead_in, sc_.initial_speed_kmh / 3.6)
+                                  : sc_.initial_front_m;
+    const double v0 = leading_ ? 0.0 : sc_.initial_speed_kmh / 3.6;
     {
       double x, z, c, sn;
       RailPoint(front - v.length_m / 2.0, x, z, c, sn);
@@ -460,7 +463,34 @@ class Simulator {
   }
 
   // ---- driver -------------------------------------------------------------------------------
+  // The lead-in (LeadInSpec): braked at standstill, then a PI speed controller on the ramp
+  // to the initial speed, jerk-limited like the hold controller.
+  void LeadInDriver(double dt, double v) {
+    const LeadInSpec& l = sc_.lead_in;
+    lead_t_ += dt;
+    if (lead_t_ < l.standstill_s) {
+      traction_ = 0.0;
+      brake_ = l.brake_cap;
+      hold_u_ = -l.brake_cap;
+      return;
+    }
+    const double target = std::min(sc_.initial_speed_kmh / 3.6, l.accel_mps2 * (lead_t_ - l.standstill_s));
+    const double e = target - v;
+    double u = 1.0 * e + 0.2 * lead_integral_;
+    if (u > -l.brake_cap && u < l.traction_cap) {
+      lead_integral_ += e * dt;
+    }
+    u = std::clamp(u, -l.brake_cap, l.traction_cap);
+    hold_u_ += std::clamp(u - hold_u_, -0.5 * dt, 0.5 * dt);
+    traction_ = std::max(hold_u_, 0.0);
+    brake_ = std::max(-hold_u_, 0.0);
+  }
+
   void Driver(double t, double dt, double v) {
+    if (leading_) {
+      LeadInDriver(dt, v);
+      return;
+    }
     const auto& cmds = sc_.driver;
     while (next_cmd_ < cmds.size() && cmds[next_cmd_].t_s <= t) {
       const auto& c = cmds[next_cmd_];
@@ -516,7 +546,9 @@ class Simulator {
   }
 
   // ---- one step -----------------------------------------------------------------------------
-  void Step(double t, double dt);
+  // One Box2D step at run time t_run (sensor timing); t the scenario's time (driver, zone
+  // windows: before 0 during a lead-in).
+  void Step(double t_run, double t, double dt);
   void SpinAxle(std::size_t i, double t, double dt, double motor_torque, double brake_torque, double rail_factor);
 
   // ---- sensors ------------------------------------------------------------------------------
@@ -542,6 +574,10 @@ class Simulator {
   std::map<long, b2Body*> pieces_;
   std::map<long, std::array<double, 2>> piece_origin_;
   std::array<AxleState, 4> axles_{};
+
+  // lead-in (kLeadIn scenarios): running until the front reaches the initial front
+  bool leading_ = false;
+  double lead_t_ = 0.0, lead_integral_ = 0.0;
 
   // driver
   std::size_t next_cmd_ = 0;
@@ -632,7 +668,7 @@ void Simulator::SpinAxle(std::size_t i, double t, double dt, double motor_torque
   a.creep = (w * r_ - v) / denom_v;
 }
 
-void Simulator::Step(double t, double dt) {
+void Simulator::Step(double t_run, double t, double dt) {
   const auto& veh = sc_.vehicle;
   std::array<double, 4> tc{}, ts{};
   for (std::size_t i = 0; i < 4; ++i) {
@@ -686,7 +722,7 @@ void Simulator::Step(double t, double dt) {
     }
     listener_.friction[i] = 0.0f;
     const double omega_before = a.omega;
-    SpinAxle(i, t, dt, motor, brake, rail);
+    SpinAxle(i, t_run, dt, motor, brake, rail);
     applied[i / 2] += veh.wheelset_inertia_kgm2 * (a.omega - omega_before) / dt + a.force_n * r_;
     wheel_[i]->ApplyForceToCenter(b2Vec2(static_cast<float>(a.force_n * tc[i]), static_cast<float>(a.force_n * ts[i])),
                                   true);
@@ -832,12 +868,28 @@ WheelRailRun Simulator::Run(const WheelRailProgress& progress) {
   std::int64_t next_progress_us = total_us / 10;
   std::int64_t prev_cycle_time_ms = 0;
 
-  const auto steps_total = total_us / step_us;
-  for (std::int64_t step = 0; step < steps_total; ++step) {
+  // The run's time starts at 0; the scenario's time (driver, zone windows, faults) at t0_us,
+  // after the lead-in. During the lead-in every scenario time lies before 0.
+  constexpr std::int64_t kBeforeScenarioUs = -(std::int64_t{1} << 50);
+  std::int64_t t0_us = 0;
+  const double lead_s = leading_ ? sc_.lead_in.standstill_s + 4.0 * (sc_.initial_speed_kmh / 3.6 / sc_.lead_in.accel_mps2 +
+                                                                      sc_.lead_in.hold_s) + 60.0
+                                 : 0.0;
+  const auto lead_limit_us = static_cast<std::int64_t>(std::llround(lead_s * 1e6));
+  for (std::int64_t step = 0;; ++step) {
     const std::int64_t t_us = step * step_us;
-    Step(static_cast<double>(t_us) * 1e-6, dt);
+    if (!leading_ && t_us - t0_us >= total_us) {
+      break;
+    }
+    if (leading_ && t_us >= lead_limit_us) {
+      throw offline::InputError(sc_.file + ": start: the lead-in did not reach the initial front " +
+                                std::to_string(sc_.initial_front_m) + " m within " + std::to_string(lead_s) + " s");
+    }
+    Step(static_cast<double>(t_us) * 1e-6,
+         leading_ ? static_cast<double>(kBeforeScenarioUs) * 1e-6 : static_cast<double>(t_us - t0_us) * 1e-6, dt);
     ++run.steps;
     const std::int64_t now_us = t_us + step_us;
+    const std::int64_t scenario_us = leading_ ? kBeforeScenarioUs : now_us - t0_us;
     // truth per step: creep and events
     for (std::size_t i = 0; i < 4; ++i) {
       const double c = axles_[i].creep;
@@ -897,7 +949,7 @@ WheelRailRun Simulator::Run(const WheelRailProgress& progress) {
     std::int64_t burst = 0;
     std::uint32_t mask = 0;
     for (const auto& f : sc_.faults) {
-      if (FaultActive(f, now_us)) {
+      if (FaultActive(f, scenario_us)) {
         mask |= 1u << static_cast<unsigned>(f.kind);
         dropout = dropout || f.kind == SensorFaultKind::kTgDropout;
         stuck = stuck || f.kind == SensorFaultKind::kTgStuck;
@@ -939,7 +991,7 @@ WheelRailRun Simulator::Run(const WheelRailProgress& progress) {
     cycle.tg.last_edge_us = tg_edge_reported_;
     // IMU and cycle faults
     for (const auto& f : sc_.faults) {
-      if (!FaultActive(f, now_us)) {
+      if (!FaultActive(f, scenario_us)) {
         continue;
       }
       switch (f.kind) {
@@ -1000,19 +1052,26 @@ WheelRailRun Simulator::Run(const WheelRailProgress& progress) {
     prev_speed = speed;
     // rail pieces around the car
     UpdatePieces(front - sc_.vehicle.length_m, front);
-    if (progress && now_us >= next_progress_us) {
-      progress(t_s, sc_.duration_s);
+    // the lead-in ends at the first cycle boundary with the front at the initial front
+    if (leading_ && front >= sc_.initial_front_m) {
+      leading_ = false;
+      t0_us = now_us;
+      run.lead_in_ms = now_us / 1000;
+      next_progress_us = t0_us + total_us / 10;
+    }
+    if (progress && !leading_ && now_us >= next_progress_us) {
+      progress(static_cast<double>(now_us - t0_us) * 1e-6, sc_.duration_s);
       next_progress_us += total_us / 10;
     }
   }
   const double front_end = FrontS();
   for (std::size_t i = 0; i < 4; ++i) {
-    close_event(i, total_us, front_end);
+    close_event(i, t0_us + total_us, front_end);
   }
   std::sort(run.events.begin(), run.events.end(), [](const SlipEvent& a, const SlipEvent& b) {
     return a.start_ms != b.start_ms ? a.start_ms < b.start_ms : a.axle < b.axle;
   });
-  run.simulated_s = static_cast<double>(total_us) * 1e-6;
+  run.simulated_s = static_cast<double>(t0_us + total_us) * 1e-6;
   return run;
 }
 

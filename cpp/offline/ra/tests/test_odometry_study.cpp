@@ -61,22 +61,29 @@ TEST(OdometryStudyMargins, TableCoversTheStudyGridAtBothRateErrors) {
   }
 }
 
-// Former method, 10 s: slip (0.92 - 0.58) / 2 * 100 = 17 m; slide coasting (0 + 1.4) / 2 * 100
-// = 70 m, braked (-0.97 + 1.4) / 2 * 100 = 21.5 m. At 25 permille each side adds
-// G g = 0.245175 m/s^2: slip (0.34 + 0.49035) * 50 = 41.5175 m.
+// Former method (D1 §3.4.3, D1's figures 2.1/3.3 km/h/s and 3.5/5.2 km/h/s), 10 s: slip
+// front 3.3 km/h/s, rear coasting: 0.916667 / 2 * 100 = 45.8333 m; slide front coasting,
+// rear 5.2 km/h/s: 1.444444 / 2 * 100 = 72.2222 m, braked (-0.972222 + 1.444444) / 2 * 100 =
+// 23.6111 m. At 25 permille each side adds G g = 0.245175 m/s^2: slip (0.916667 + 0.49035)
+// * 50 = 70.3508 m.
 // @verifies REQ-RA-014
 TEST(OdometryStudyMargins, BaselineExtensionFormula) {
   const VehicleAccelBounds b = D1VehicleBounds();
+  EXPECT_NEAR(b.accel_min, 2.1 / 3.6, 1e-12);
+  EXPECT_NEAR(b.accel_max, 3.3 / 3.6, 1e-12);
+  EXPECT_NEAR(b.decel_min, 3.5 / 3.6, 1e-12);
+  EXPECT_NEAR(b.decel_max, 5.2 / 3.6, 1e-12);
   const BaselineExtension level = BaselineExtensionM(10.0, 0.0, b);
-  EXPECT_NEAR(level.slip_m, 17.0, 1e-9);
-  EXPECT_NEAR(level.slide_m, 70.0, 1e-9);
-  EXPECT_NEAR(level.slide_braked_m, 21.5, 1e-9);
-  EXPECT_NEAR(level.worst_m, 70.0, 1e-9);
+  EXPECT_NEAR(level.slip_m, 3.3 / 3.6 * 50.0, 1e-9);
+  EXPECT_NEAR(level.slide_m, 5.2 / 3.6 * 50.0, 1e-9);
+  EXPECT_NEAR(level.slide_braked_m, (5.2 - 3.5) / 3.6 * 50.0, 1e-9);
+  EXPECT_NEAR(level.worst_m, 5.2 / 3.6 * 50.0, 1e-9);
+  EXPECT_NEAR(level.slip_m, 45.8333, 1e-4);
   const BaselineExtension steep = BaselineExtensionM(10.0, 25.0, b);
-  EXPECT_NEAR(steep.slip_front_accel, 0.92 + 0.245175, 1e-9);
-  EXPECT_NEAR(steep.slip_rear_accel, 0.58 - 0.245175, 1e-9);
-  EXPECT_NEAR(steep.slip_m, 41.5175, 1e-9);
-  EXPECT_NEAR(steep.slide_m, (0.245175 + 1.4 + 0.245175) * 50.0, 1e-9);
+  EXPECT_NEAR(steep.slip_front_accel, 3.3 / 3.6 + 0.245175, 1e-9);
+  EXPECT_NEAR(steep.slip_rear_accel, -0.245175, 1e-9);
+  EXPECT_NEAR(steep.slip_m, 70.3508, 1e-4);
+  EXPECT_NEAR(steep.slide_m, (0.245175 + 5.2 / 3.6 + 0.245175) * 50.0, 1e-9);
   // symmetric in the sign of the gradient (steepest magnitude)
   EXPECT_DOUBLE_EQ(BaselineExtensionM(10.0, -25.0, b).slip_m, steep.slip_m);
 }

@@ -147,6 +147,7 @@ TEST(WheelRailPhysics, CoastingAccelerationIsGravityComponent) {
     auto j = BaseScenario(g);
     NoResistance(j);
     j["initial_speed_kmh"] = 60;
+    j["start"] = "in_motion";  // the simulator alone: the run begins in motion
     j["driver"] = {{{"t_s", 0}, {"brake", 0.0}, {"ramp_s", 0}}};
     const auto sc = Scenario(j);
     const auto run = SimulateWheelRail(sc);
@@ -166,6 +167,7 @@ TEST(WheelRailPhysics, TorqueBeyondAdhesionSlipsAndTruthReportsIt) {
   j["duration_s"] = 12;
   j["rail"]["condition"] = "wet";
   j["initial_speed_kmh"] = 30;
+  j["start"] = "in_motion";  // the simulator alone: the run begins in motion
   // wet at 30 km/h: mu_peak = 0.55 x (7.5/74 + 0.161) = 0.1443, about 12.5 kN per axle;
   // the motored axles demand 17 kN at full notch
   j["driver"] = {{{"t_s", 0}, {"traction", 0.3}, {"ramp_s", 0}},
@@ -201,6 +203,7 @@ TEST(WheelRailPhysics, WetPeakAdhesionIs55PercentOfDry) {
     j["duration_s"] = 8;
     j["rail"]["condition"] = condition;
     j["initial_speed_kmh"] = 20;
+    j["start"] = "in_motion";  // the simulator alone: the run begins in motion
     j["vehicle"]["max_traction_force_n"] = 40000;
     j["vehicle"]["max_power_w"] = 2000000;
     j["driver"] = {{{"t_s", 0}, {"traction", 0.0}, {"ramp_s", 0}}, {{"t_s", 1}, {"traction", 1.0}, {"ramp_s", 6}}};
@@ -267,6 +270,7 @@ TEST(WheelRailSensors, ImuInCantedCurveAtConstantSpeed) {
   auto j = BaseScenario(0.0);
   NoResistance(j);
   j["initial_speed_kmh"] = 72;  // 20 m/s
+  j["start"] = "in_motion";  // the simulator alone: the run begins in motion
   j["driver"] = {{{"t_s", 0}, {"brake", 0.0}, {"ramp_s", 0}}};
   j["vehicle"]["roll_coefficient"] = 0.0;
   j["duration_s"] = 12;
@@ -304,6 +308,7 @@ TEST(WheelRailSensors, TgPulsesMatchWheelRotation) {
   auto j = BaseScenario(0.0);
   j["duration_s"] = 20;
   j["initial_speed_kmh"] = 50;
+  j["start"] = "in_motion";  // the simulator alone: the run begins in motion
   j["driver"] = {{{"t_s", 0}, {"brake", 0.0}, {"ramp_s", 0}}};
   const auto sc = Scenario(j);
   const auto run = SimulateWheelRail(sc);
@@ -333,6 +338,7 @@ TEST(WheelRailSensors, TgPulsesMatchWheelRotation) {
 TEST(WheelRailSensors, BaliseFixAtPassage) {
   auto j = BaseScenario(0.0);
   j["initial_speed_kmh"] = 36;
+  j["start"] = "in_motion";  // the simulator alone: the run begins in motion
   j["driver"] = {{{"t_s", 0}, {"brake", 0.0}, {"ramp_s", 0}}};
   j["balises"] = {{{"id", "B1"}, {"position_m", 540}}};
   const auto run = SimulateWheelRail(Scenario(j));
@@ -353,6 +359,7 @@ TEST(WheelRailSensors, BaliseFixAtPassage) {
 TEST(WheelRailSensors, InjectedFaults) {
   auto j = BaseScenario(0.0);
   j["initial_speed_kmh"] = 36;
+  j["start"] = "in_motion";  // the simulator alone: the run begins in motion
   j["driver"] = {{{"t_s", 0}, {"brake", 0.0}, {"ramp_s", 0}}};
   j["faults"] = {{{"type", "imu_nan"}, {"from_s", 1.0}, {"to_s", 1.1}},
                  {{"type", "imu_gap"}, {"from_s", 2.0}, {"to_s", 2.1}, {"samples", 7}},
@@ -386,6 +393,7 @@ TEST(WheelRailSensors, InjectedFaults) {
 TEST(WheelRailSensors, StuckTgLosesPulses) {
   auto j = BaseScenario(0.0);
   j["initial_speed_kmh"] = 36;
+  j["start"] = "in_motion";  // the simulator alone: the run begins in motion
   j["driver"] = {{{"t_s", 0}, {"brake", 0.0}, {"ramp_s", 0}}};
   j["faults"] = {{{"type", "tg_stuck"}, {"from_s", 3.0}, {"to_s", 5.0}}};
   const auto run = SimulateWheelRail(Scenario(j));
@@ -400,6 +408,7 @@ TEST(WheelRailRun, DeterministicForASeed) {
   auto j = BaseScenario(25.0);
   j["imu"] = nlohmann::json::object();
   j["initial_speed_kmh"] = 40;
+  j["start"] = "in_motion";  // the simulator alone: the run begins in motion
   j["rail"]["condition"] = "wet";
   j["driver"] = {{{"t_s", 0}, {"traction", 1.0}, {"ramp_s", 1}}};
   const auto sc = Scenario(j);
@@ -456,10 +465,65 @@ TEST(WheelRailLoader, RejectsBadScenarios) {
                             {"/nonexistent/x.json: cannot read"});
 }
 
+// How a run begins (REQ-RA-015): required in motion, consistent with the speed, and a
+// lead-in must not cross an adhesion zone.
+// @verifies REQ-RA-015
+TEST(WheelRailLoader, StartOfTheRun) {
+  ExpectError([](auto& j) { j["initial_speed_kmh"] = 40; }, {"missing key 'start'"});
+  ExpectError([](auto& j) { j["start"] = "lead_in"; }, {"start", "at_rest is a start at speed 0"});
+  ExpectError(
+      [](auto& j) {
+        j["initial_speed_kmh"] = 40;
+        j["start"] = "at_rest";
+      },
+      {"start", "with initial_speed_kmh 40"});
+  ExpectError(
+      [](auto& j) {
+        j["initial_speed_kmh"] = 40;
+        j["start"] = "gliding";
+      },
+      {"start", "unknown start 'gliding'"});
+  ExpectError(
+      [](auto& j) {
+        j["initial_speed_kmh"] = 40;
+        j["start"] = "lead_in";
+        j["rail"]["zones"] = {{{"begin_m", 300}, {"end_m", 310}, {"factor", 0.5}}};
+      },
+      {"start", "crosses the adhesion zone [300, 310)"});
+}
+
+// A lead-in: at rest for its standstill time, then up to the initial speed; the front reaches
+// the initial front at the scenario's t = 0 (lead_in_ms) at about the initial speed; the
+// first gradient is extended back over the lead-in.
+// @verifies REQ-RA-015
+TEST(WheelRailRun, LeadInEndsAtTheInitialFrontAndSpeed) {
+  auto j = BaseScenario(0.0);
+  j["duration_s"] = 5;
+  j["initial_speed_kmh"] = 36;
+  j["start"] = "lead_in";
+  j["driver"] = {{{"t_s", 0}, {"traction", 0.5}, {"brake", 0.5}, {"hold_kmh", 36}, {"ramp_s", 0}}};
+  const auto sc = Scenario(j);
+  EXPECT_EQ(sc.start, ScenarioStart::kLeadIn);
+  EXPECT_LT(sc.vertical.begin_m, sc.initial_front_m - LeadInDistanceM(sc.lead_in, 10.0) - sc.vehicle.length_m);
+  EXPECT_EQ(sc.vertical.gradients.front().from_m, sc.vertical.begin_m);
+  const auto run = SimulateWheelRail(sc);
+  ASSERT_GT(run.lead_in_ms, 0);
+  const auto t0 = static_cast<std::size_t>(run.lead_in_ms / 100 - 1);  // the cycle ending at t = 0
+  ASSERT_LT(t0 + 1, run.truth.size());
+  EXPECT_EQ(run.truth.size(), static_cast<std::size_t>((run.lead_in_ms + 5'000) / 100));
+  for (std::size_t k = 0; k * 100 < static_cast<std::size_t>(sc.lead_in.standstill_s * 1000.0) - 100; ++k) {
+    EXPECT_EQ(run.cycles[k].tg.pulses, run.cycles[0].tg.pulses) << k;  // no TG pulse at standstill
+  }
+  EXPECT_GE(run.truth[t0].front_m, sc.initial_front_m);
+  EXPECT_LT(run.truth[t0].front_m, sc.initial_front_m + 1.5);
+  EXPECT_NEAR(run.truth[t0].speed_mps, 10.0, 0.3);
+}
+
 TEST(WheelRailLoader, TrainLeavingTheAlignmentIsAnError) {
   auto j = BaseScenario(0.0);
   j["initial_front_m"] = 2990;
   j["initial_speed_kmh"] = 36;
+  j["start"] = "in_motion";  // the simulator alone: the run begins in motion
   j["driver"] = {{{"t_s", 0}, {"brake", 0.0}, {"ramp_s", 0}}};
   EXPECT_THROW((void)SimulateWheelRail(Scenario(j)), offline::InputError);
 }

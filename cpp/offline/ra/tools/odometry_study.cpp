@@ -1,5 +1,5 @@
 // odometry_study: offline study of the on-board odometry (spec/design/ra.md §1; D1 §3
-// items 6-9, D1 §5.2; REQ-RA-003..010, REQ-RA-014).
+// items 6-9, D1 §5.2; REQ-RA-003..010, REQ-RA-014, REQ-RA-015).
 //
 // For every wheel-rail scenario (spec/wheelrail/*.json): simulate (Box2D), replay the
 // odometry with the IMU method and the configured start points (2), with one start point,
@@ -63,13 +63,15 @@ Options ParseArgs(int argc, char** argv) {
   Options o;
   char description[2048];
   std::snprintf(description, sizeof description,
-                "Offline odometry study (REQ-RA-003..010, REQ-RA-014; D1 §3 items 6-9, D1 §5.2).\n"
+                "Offline odometry study (REQ-RA-003..010, REQ-RA-014, REQ-RA-015; D1 §3 items 6-9, D1 §5.2).\n"
                 "Every scenario (schema railproof/wheelrail-scenario/1) is simulated and replayed with the\n"
                 "IMU method (configured start points), with one start point and with the former\n"
                 "max/min-acceleration method. Checks: the true distance error at re-adhesion of every\n"
                 "compensation of the configured method within the error bound (ratio <= 1); the true\n"
                 "front inside the reported envelope in every cycle with a valid position (both IMU\n"
-                "runs); scenarios with expect_safe_reaction end in a maximum-time stop; sensor faults\n"
+                "runs); every run's start-up against the truth (a valid position from the end of a\n"
+                "warm-up at standstill, none after a start in motion until a warm-up and a balise);\n"
+                "scenarios with expect_safe_reaction end in a maximum-time stop; sensor faults\n"
                 "give the typed rejection and stop reason; every train type's readhesion_margin_mm\n"
                 "covers the error model at %lld ms, %.4f deg/s and the steepest gradient of its line.",
                 static_cast<long long>(rp::max_compensation_ms), static_cast<double>(rp::imu_rate_error_udeg_s) / 1e6);
@@ -602,9 +604,9 @@ int Main(int argc, char** argv) {
     j["tool"] = "odometry_study";
     j["schema"] = "railproof/odometry-study/1";
     j["requirements"] = Json::array({"REQ-RA-003", "REQ-RA-004", "REQ-RA-005", "REQ-RA-006", "REQ-RA-007", "REQ-RA-008",
-                                     "REQ-RA-009", "REQ-RA-010", "REQ-RA-014"});
+                                     "REQ-RA-009", "REQ-RA-010", "REQ-RA-014", "REQ-RA-015"});
     j["verdict"] = pass ? "PASS" : "FAIL";
-    j["source"] = Json::array({"D1 §3 items 6-9", "D1 §5.2", "D5 §7.4.2", "ASM-024", "ASM-027"});
+    j["source"] = Json::array({"D1 §3 items 6-9", "D1 §5.2", "D5 §7.4.2", "ASM-024", "ASM-027", "ASM-031"});
     j["worst_bound_ratio"] = Ratio(worst);
     j["worst_bound_ratio_at"] = worst_at;
     j["worst_bound_ratio_single_start_point"] = Ratio(worst_1sp);

@@ -8,13 +8,14 @@
 //   railproof_conformance_ra --vectors DIR [--junit FILE] [gtest flags]
 //
 // Each file's header gives the machine configuration of its vectors (confirm_cycles,
-// start_points, spacing_cycles: ra::MachineConfig, which must validate). Each vector
-// starts from a fresh machine. Each step is one cycle: the predicates (deviation,
-// speed_agrees, imu_ok, tg_ok, balise), the section limits and the start-point age go to
+// start_points, spacing_cycles, warmup_cycles: ra::MachineConfig, which must validate). Each
+// vector starts from a fresh machine (stopped at start-up). Each step is one cycle: the
+// predicates (deviation, speed_agrees, imu_ok, tg_ok, balise, tg_moving), the section limits and the start-point age go to
 // ReadhesionMachine::Step (model ticks are cycles, the model's margins mm: header "units"),
 // which must accept them; expected: every field of the machine state after the cycle
 // (mode, stop reason, deviation count, both candidates, t_max and margin in force, stop
-// demand, position validity, the detection, adoption and balise-reset events). On a
+// demand, position validity, the trust in the TG history and the warm-up count, the
+// detection, adoption and balise-reset events). On a
 // mismatch the failure names the vector, the step, the field, expected and actual.
 // Last line: "railproof-conformance-ra: all N vectors passed" or
 // "railproof-conformance-ra: vectors mismatched: K of N" or "...: error: <reason>".
@@ -51,7 +52,7 @@ bool StepWellFormed(const std::string& /*file*/, const json& step) {
   }
   const json& in = step["in"];
   const json& out = step["out"];
-  for (const char* k : {"deviation", "imu_ok", "tg_ok", "balise"}) {
+  for (const char* k : {"deviation", "imu_ok", "tg_ok", "balise", "tg_moving"}) {
     if (!IsBool(in, k)) {
       return false;
     }
@@ -65,12 +66,12 @@ bool StepWellFormed(const std::string& /*file*/, const json& step) {
       return false;
     }
   }
-  for (const char* k : {"deviation_count", "max_compensation_cycles", "margin_mm"}) {
+  for (const char* k : {"deviation_count", "max_compensation_cycles", "margin_mm", "rest_cycles"}) {
     if (!IsInt(out, k)) {
       return false;
     }
   }
-  for (const char* k : {"stop_demand", "position_valid", "detected", "balise_reset"}) {
+  for (const char* k : {"stop_demand", "position_valid", "trusted", "detected", "balise_reset"}) {
     if (!IsBool(out, k)) {
       return false;
     }
@@ -93,18 +94,22 @@ bool StepWellFormed(const std::string& /*file*/, const json& step) {
 // The machine configuration of a file's header; "" or the reason it is unusable.
 std::string ConfigFromHeader(const json& obj, ro::MachineConfig& cfg) {
   const json& p = obj["parameters"];
-  if (!p.is_object() || !IsInt(p, "confirm_cycles") || !IsInt(p, "start_points") || !IsInt(p, "spacing_cycles")) {
-    return "header parameters need integer confirm_cycles, start_points, spacing_cycles";
+  if (!p.is_object() || !IsInt(p, "confirm_cycles") || !IsInt(p, "start_points") || !IsInt(p, "spacing_cycles") ||
+      !IsInt(p, "warmup_cycles")) {
+    return "header parameters need integer confirm_cycles, start_points, spacing_cycles, warmup_cycles";
   }
   const std::int64_t confirm = p["confirm_cycles"].get<std::int64_t>();
   const std::int64_t points = p["start_points"].get<std::int64_t>();
   const std::int64_t spacing = p["spacing_cycles"].get<std::int64_t>();
-  if (confirm < 0 || confirm > 255 || points < 0 || points > 255 || spacing < INT32_MIN || spacing > INT32_MAX) {
+  const std::int64_t warmup = p["warmup_cycles"].get<std::int64_t>();
+  if (confirm < 0 || confirm > 255 || points < 0 || points > 255 || spacing < INT32_MIN || spacing > INT32_MAX ||
+      warmup < INT32_MIN || warmup > INT32_MAX) {
     return "header machine configuration out of range";
   }
   cfg.confirm_cycles = static_cast<std::uint8_t>(confirm);
   cfg.start_points = static_cast<std::uint8_t>(points);
   cfg.spacing_cycles = static_cast<std::int32_t>(spacing);
+  cfg.warmup_cycles = static_cast<std::int32_t>(warmup);
   if (const ro::MachineError e = ro::ReadhesionMachine::Validate(cfg); e != ro::MachineError::kNone) {
     return std::string("header machine configuration rejected: ") + ro::ToString(e);
   }
@@ -136,6 +141,7 @@ void Replay(const rcli::JsonVector& v, std::vector<std::string>& problems) {
     p.imu_ok = in.at("imu_ok").get<bool>();
     p.tg_ok = in.at("tg_ok").get<bool>();
     p.balise = in.at("balise").get<bool>();
+    p.tg_moving = in.at("tg_moving").get<bool>();
     p.section.max_compensation_cycles = in.at("section").at("max_compensation_cycles").get<std::int32_t>();
     p.section.margin_mm = in.at("section").at("margin_mm").get<std::int64_t>();
     p.start_age_cycles = in.at("start_age_cycles").get<std::int32_t>();
@@ -162,6 +168,8 @@ void Replay(const rcli::JsonVector& v, std::vector<std::string>& problems) {
     chk.Expect("margin_mm", num(out.at("margin_mm")), std::to_string(s.margin_mm));
     chk.Expect("stop_demand", Bool(out.at("stop_demand").get<bool>()), Bool(s.stop_demand));
     chk.Expect("position_valid", Bool(out.at("position_valid").get<bool>()), Bool(s.position_valid));
+    chk.Expect("trusted", Bool(out.at("trusted").get<bool>()), Bool(s.trusted));
+    chk.Expect("rest_cycles", num(out.at("rest_cycles")), std::to_string(s.rest_cycles));
     chk.Expect("detected", Bool(out.at("detected").get<bool>()), Bool(s.detected));
     chk.Expect("adopted", rcli::OptInt(out.at("adopted")), Adopted(s.adopted));
     chk.Expect("balise_reset", Bool(out.at("balise_reset").get<bool>()), Bool(s.balise_reset));

@@ -80,15 +80,28 @@ void Odometry::InitCandidate(CandidateState& c, std::int64_t start, bool slip) c
     c.psi = std::fabs(e.az) > 1e-9 ? std::atan((e.ay - v0 * e.wz) / e.az) : 0.0;
     c.ax_prev = RAILPROOF_FAULT(FAULT_RA_NO_GRAVITY_COMPENSATION) ? e.ax : e.ax - kG * std::sin(c.theta);
   } else {
-    // Baseline (design note §8): front with the maximum acceleration (slip) or the least
-    // deceleration, coasting on the steepest falling gradient (slide); rear with the
-    // opposite bound (the most deceleration, on the steepest rising gradient).
-    const double grade = kG * static_cast<double>(episode_gradient_x10_) / 10'000.0;
-    c.a_front = (slip ? static_cast<double>(cfg_.accel_max_mm_s2) / 1000.0 : 0.0) + grade;
-    c.a_rear = -(static_cast<double>(cfg_.decel_max_mm_s2) / 1000.0 + grade);
+    // Baseline (design note §8, D1 §3.4.3): a slip advances the front with the maximum
+    // acceleration and the rear with the minimum acceleration including coasting (coasting);
+    // a slide the front with the least deceleration including coasting (coasting) and the
+    // rear with the maximum deceleration; the gravity component of the steepest gradient on
+    // top (falling for the front, rising for the rear).
+    BaselineAccelerations(c, slip);
     c.v_hi = std::max({v0, v0_delay, 0.0});
     c.v_lo = std::max(std::min(v0, v0_delay), 0.0);
     c.x_hi_um = c.x_lo_um = c.base_um;
+  }
+}
+
+// The former method's acceleration bounds of a candidate (design note §8, D1 §3.4.3).
+// @implements REQ-RA-014
+void Odometry::BaselineAccelerations(CandidateState& c, bool slip) const noexcept {
+  const double grade = kG * static_cast<double>(episode_gradient_x10_) / 10'000.0;
+  if (slip) {
+    c.a_front = static_cast<double>(cfg_.accel_max_mm_s2) / 1000.0 + grade;
+    c.a_rear = -grade;  // coasting: the minimum acceleration including coasting
+  } else {
+    c.a_front = grade;  // coasting: the least deceleration including coasting
+    c.a_rear = -(static_cast<double>(cfg_.decel_max_mm_s2) / 1000.0 + grade);
   }
 }
 
@@ -109,9 +122,7 @@ void Odometry::AdvanceCandidate(CandidateState& c, const HistoryEntry& e) const 
     c.ax_prev = ax;
   } else {
     // the episode's steepest gradient only grows, so the bounds only widen
-    const double grade = kG * static_cast<double>(episode_gradient_x10_) / 10'000.0;
-    c.a_front = (c.slip ? static_cast<double>(cfg_.accel_max_mm_s2) / 1000.0 : 0.0) + grade;
-    c.a_rear = -(static_cast<double>(cfg_.decel_max_mm_s2) / 1000.0 + grade);
+    BaselineAccelerations(c, c.slip);
     const double hi1 = c.v_hi + c.a_front * kDt;
     c.x_hi_um += 0.5 * (c.v_hi + hi1) * kDt * 1e6;
     c.v_hi = hi1;

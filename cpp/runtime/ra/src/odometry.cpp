@@ -44,6 +44,14 @@ static_assert(p::moving_average_ms % p::cycle_ms == 0 && p::tg_window_ms % p::cy
 static_assert(p::history_cycles >= (p::lookback_ms + p::search_depth_ms + p::parallel_spacing_ms) / p::cycle_ms + 3,
               "history too short for the start-point search and the second start point");
 
+// The state machine of an odometry configuration: the warm-up at standstill fills the
+// moving averages and the TG window (REQ-RA-015), the history the detection compares.
+MachineConfig MachineConfigOf(const OdometryConfig& cfg) noexcept {
+  return MachineConfig{static_cast<std::uint8_t>(p::confirm_cycles), cfg.start_points,
+                       static_cast<std::int32_t>(p::parallel_spacing_ms / p::cycle_ms),
+                       static_cast<std::int32_t>(kAvgCycles + kWindowCycles)};
+}
+
 // ceil(a / b) for a >= 0, b > 0.
 constexpr std::int64_t CeilDiv(std::int64_t a, std::int64_t b) noexcept { return (a + b - 1) / b; }
 
@@ -109,9 +117,7 @@ ConfigError Odometry::Create(const OdometryConfig& cfg, Odometry& out) noexcept 
       cfg.initial_front_mm >= cfg.sections[cfg.section_count - 1].end_mm) {
     return ConfigError::kInitialOutside;
   }
-  const MachineConfig mc{static_cast<std::uint8_t>(p::confirm_cycles), cfg.start_points,
-                         static_cast<std::int32_t>(p::parallel_spacing_ms / p::cycle_ms)};
-  if (ReadhesionMachine::Validate(mc) != MachineError::kNone) return ConfigError::kStartPoints;
+  if (ReadhesionMachine::Validate(MachineConfigOf(cfg)) != MachineError::kNone) return ConfigError::kStartPoints;
   out.Init(cfg);
   return ConfigError::kNone;
 }
@@ -164,10 +170,12 @@ void Odometry::Init(const OdometryConfig& cfg) noexcept {
     if (l.limits.margin_mm == prev_margin_mm_) break;
     prev_margin_mm_ = l.limits.margin_mm;
   }
-  const MachineConfig mc{static_cast<std::uint8_t>(p::confirm_cycles), cfg.start_points,
-                         static_cast<std::int32_t>(p::parallel_spacing_ms / p::cycle_ms)};
-  machine_ = ReadhesionMachine(mc);
+  machine_ = ReadhesionMachine(MachineConfigOf(cfg));
   out_ = OdometryOutput{};
+  out_.mode = machine_.state().mode;  // stopped at start-up until the warm-up (REQ-RA-015)
+  out_.stop_reason = machine_.state().stop_reason;
+  out_.position_valid = machine_.state().position_valid;
+  out_.stop_demand = machine_.state().stop_demand;
   out_.front_mm = cfg.initial_front_mm;
   out_.last_balise_mm = cfg.initial_front_mm;
   out_.margin_mm = cfg.method == Method::kImu ? prev_margin_mm_ : 0;
@@ -482,6 +490,11 @@ void Odometry::Accept(const CycleInput& in) noexcept {
   Predicates pr;
   pr.section = lim.limits;
   pr.balise = balise;
+  // A TG pulse since the previous cycle of the history (REQ-RA-015). The first cycle of a
+  // (re)started history has no count to compare and counts as a rest cycle: the warm-up's
+  // warmup_cycles cycles are then exactly the entries the deviation predicate needs full
+  // (a train moving at the first cycle shows its pulses in the second).
+  pr.tg_moving = i > 0 && e.pulses != At(i - 1).pulses;
   const bool low = e.v_tg < kLowSpeed;
   const double res = low ? pulse_um_ * 1e-6 : 0.0;  // p / 1 s (m/s) and p / 1 s^2 (m/s^2)
   const double ta = static_cast<double>(cfg_.detect_threshold_mm_s2) / 1000.0;

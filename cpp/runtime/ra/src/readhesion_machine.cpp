@@ -9,6 +9,9 @@
 //   FAULT_RA_EPISODE_RELAXES       the episode takes the current section's limits only
 //   FAULT_RA_LAST_CANDIDATE_WINS   the highest index wins when both confirm in one cycle
 //   FAULT_RA_TG_FAILURE_IGNORED    a TG failure does not stop the train
+//   FAULT_RA_WARMUP_COUNTS_MOTION  the warm-up counts cycles with TG pulses (a start in motion is trusted)
+//   FAULT_RA_BALISE_WITHOUT_WARMUP a balise ends a stop before the history is trusted
+//   FAULT_RA_TRUST_KEPT_ON_DEVIATION a deviation run while stopped keeps the history trusted
 #include "railproof/core/seeded_fault.hpp"
 #include "railproof/ra/readhesion_machine.hpp"
 
@@ -20,6 +23,7 @@ MachineError ReadhesionMachine::Validate(const MachineConfig& cfg) noexcept {
   if (cfg.confirm_cycles < 1 || cfg.confirm_cycles > 100) return MachineError::kConfirmCyclesInvalid;
   if (cfg.start_points < 1 || cfg.start_points > kMaxStartPoints) return MachineError::kStartPointsInvalid;
   if (cfg.spacing_cycles < 1 || cfg.spacing_cycles > 10000) return MachineError::kSpacingInvalid;
+  if (cfg.warmup_cycles < 1 || cfg.warmup_cycles > 10000) return MachineError::kWarmupInvalid;
   return MachineError::kNone;
 }
 
@@ -27,16 +31,38 @@ void ReadhesionMachine::Discard() noexcept {
   for (auto& c : s_.candidates) c = Candidate{};
 }
 
-// @implements REQ-RA-007 REQ-RA-013
+// Every stop withdraws the trust in the TG history: a timeout may leave the TG slipping, a
+// sensor failure restarts the history (REQ-RA-015).
+// @implements REQ-RA-007 REQ-RA-013 REQ-RA-015
 void ReadhesionMachine::Stop(StopReason reason) noexcept {
   Discard();
   s_.mode = Mode::kStopped;
   s_.stop_reason = reason;
   s_.stop_demand = true;
   s_.position_valid = false;
+  s_.trusted = false;
+  s_.rest_cycles = 0;
 }
 
-// @implements REQ-RA-003 REQ-RA-006 REQ-RA-007 REQ-RA-009 REQ-RA-010 REQ-RA-012 REQ-RA-013
+// 2a. The warm-up at standstill (REQ-RA-015): warmup_cycles healthy cycles in a row without
+// a TG pulse make the history trusted; a pulse restarts the count and makes the start-up a
+// start in motion.
+// @implements REQ-RA-015
+void ReadhesionMachine::WarmUp(bool tg_moving) noexcept {
+  if (s_.trusted) return;
+  if (tg_moving && !RAILPROOF_FAULT(FAULT_RA_WARMUP_COUNTS_MOTION)) {
+    s_.rest_cycles = 0;
+    if (s_.stop_reason == StopReason::kStartUp) s_.stop_reason = StopReason::kStartInMotion;
+  } else if (s_.rest_cycles < cfg_.warmup_cycles) {
+    s_.rest_cycles += 1;
+  }
+  if (s_.rest_cycles >= cfg_.warmup_cycles) {
+    s_.trusted = true;
+    s_.rest_cycles = 0;
+  }
+}
+
+// @implements REQ-RA-003 REQ-RA-006 REQ-RA-007 REQ-RA-009 REQ-RA-010 REQ-RA-012 REQ-RA-013 REQ-RA-015
 MachineError ReadhesionMachine::Step(const Predicates& in) noexcept {
   if (in.section.max_compensation_cycles < 1 || in.section.margin_mm < 0) {
     return MachineError::kSectionInvalid;
@@ -70,20 +96,38 @@ MachineError ReadhesionMachine::Step(const Predicates& in) noexcept {
     return MachineError::kNone;
   }
 
+  const bool was_trusted = s_.trusted;
+  WarmUp(in.tg_moving);
+
   switch (s_.mode) {
-    case Mode::kStopped:
-      // 3. Held until a balise fix with healthy sensors re-establishes the position.
+    case Mode::kStopped: {
+      // 3. Held until the history is trusted and a balise fix with healthy sensors
+      // re-establishes the position; the start-up without motion needs only the warm-up.
+      // While waiting with the history trusted, confirm_cycles deviations in a row withdraw
+      // the trust: a TG wheel that was locked through the "standstill" and rolls again shows
+      // as one (REQ-RA-015).
       s_.stop_demand = true;
       s_.position_valid = false;
-      if (in.balise) {
+      if (was_trusted) {
+        s_.deviation_count = in.deviation ? static_cast<std::uint8_t>(s_.deviation_count + 1) : 0;
+        if (s_.deviation_count >= cfg_.confirm_cycles && !RAILPROOF_FAULT(FAULT_RA_TRUST_KEPT_ON_DEVIATION)) {
+          s_.trusted = false;
+          s_.rest_cycles = 0;
+          s_.deviation_count = 0;
+        }
+      }
+      const bool ends = (s_.trusted || (RAILPROOF_FAULT(FAULT_RA_BALISE_WITHOUT_WARMUP) && in.balise)) &&
+                        (in.balise || s_.stop_reason == StopReason::kStartUp);
+      if (ends) {
         s_.mode = Mode::kTg;
         s_.stop_reason = StopReason::kNone;
         s_.stop_demand = false;
         s_.position_valid = true;
         s_.deviation_count = 0;
-        s_.balise_reset = true;
+        s_.balise_reset = in.balise;
       }
       return MachineError::kNone;
+    }
 
     case Mode::kTg: {
       // 4. Detection after confirm_cycles consecutive deviations (REQ-RA-003).

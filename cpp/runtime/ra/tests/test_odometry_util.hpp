@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -36,8 +37,8 @@ inline OdometryConfig Config(const std::vector<OdometrySection>& sections, Metho
                         .start_points = 2,
                         .imu_rate_error_udeg_s = 2'500,
                         .length_correction_ppm = 1'000,
-                        .accel_max_mm_s2 = 920,
-                        .decel_max_mm_s2 = 1'400,
+                        .accel_max_mm_s2 = OdometryConfig{}.accel_max_mm_s2,  // D1's figures
+                        .decel_max_mm_s2 = OdometryConfig{}.decel_max_mm_s2,
                         .sections = sections.data(),
                         .section_count = static_cast<int>(sections.size()),
                         .initial_front_mm = kInitialFrontMm};
@@ -147,6 +148,62 @@ class Stream {
   std::int64_t time_ms_ = 0;
 };
 
+
+// The warm-up at standstill the odometry needs after its start (REQ-RA-015): the moving
+// averages plus the TG window.
+inline constexpr int kWarmupCycles =
+    static_cast<int>((params::ra::moving_average_ms + params::ra::tg_window_ms) / params::ra::cycle_ms);
+
+// A running train whose odometry is trusted (REQ-RA-015): a fresh odometry and a stream at
+// standstill; the warm-up, a run-up to v0 at `accel` (the IMU measuring it; `level` are the
+// IMU values at rest, e.g. OnGradient), then kSettleCycles at v0 so that the averages and
+// the TG window hold the constant speed only. The test's own cycles follow; the stream's
+// true front and pulse count stay relative to its first sample, taken at standstill.
+inline constexpr int kSettleCycles = kWarmupCycles + 5;
+inline std::vector<CycleInput> RunUpInputs(Stream& s, double v0, const ImuValues& level = {}, double accel = 1.0) {
+  std::vector<CycleInput> v;
+  for (int k = 0; k < kWarmupCycles; ++k) v.push_back(s.Next({}, level));
+  while (s.speed() < v0 - 1e-9) {
+    const double a = std::min(accel, (v0 - s.speed()) / 0.1);
+    ImuValues m = level;
+    m.ax += a;
+    v.push_back(s.Next({a, 0.0}, m));
+  }
+  for (int k = 0; k < kSettleCycles; ++k) v.push_back(s.Next({}, level));
+  return v;
+}
+inline void RunUp(Odometry& od, Stream& s, double v0, const ImuValues& level = {}, double accel = 1.0) {
+  for (const CycleInput& in : RunUpInputs(s, v0, level, accel)) {
+    EXPECT_FALSE(od.Step(in).detected) << "run-up, cycle at " << in.time_ms << " ms";
+  }
+  ASSERT_EQ(od.output().mode, Mode::kTg);
+  ASSERT_TRUE(od.output().position_valid);
+}
+
+// After a stop demand: the train brakes to a standstill at 1 m/s^2 (the IMU measuring it)
+// and stands for the warm-up, the stop demand held throughout; each cycle passes through
+// `adjust` first (e.g. a restarted counter's offset). The history is then trusted again
+// (REQ-RA-015) and the next balise ends the stop.
+template <typename Adjust>
+void BrakeAndWarmUp(Odometry& od, Stream& s, Adjust adjust) {
+  while (s.speed() > 1e-9) {
+    const double a = -std::min(1.0, s.speed() / 0.1);
+    ImuValues m;
+    m.ax = a;
+    CycleInput in = s.Next({a, 0.0}, m);
+    adjust(in);
+    EXPECT_TRUE(od.Step(in).stop_demand) << "braking at " << s.speed() << " m/s";
+  }
+  for (int k = 0; k < kWarmupCycles; ++k) {
+    CycleInput in = s.Next();
+    adjust(in);
+    EXPECT_TRUE(od.Step(in).stop_demand) << "warm-up cycle " << k;
+  }
+  EXPECT_TRUE(od.machine().state().trusted);
+}
+inline void BrakeAndWarmUp(Odometry& od, Stream& s) {
+  BrakeAndWarmUp(od, s, [](CycleInput&) {});
+}
 
 // v[k] with an int index.
 template <typename T>

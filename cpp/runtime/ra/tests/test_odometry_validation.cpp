@@ -167,14 +167,17 @@ std::vector<Injection> Injections() {
 
 // Each reason is reported, and in the same cycle the position is invalid and a stop is
 // demanded, with the stop reason of the failed sensor; the reaction is held on later valid
-// cycles and ends at a balise fix with both sensors valid.
+// cycles, also at a balise read while the train still runs, and ends at a balise fix with
+// both sensors valid after the train has stood for the warm-up (REQ-RA-015).
 // @verifies REQ-RA-013
 // @verifies REQ-RA-007
+// @verifies REQ-RA-015
 TEST(OdometryInput, EveryReasonGivesTheSafeReaction) {
   for (const Injection& inj : Injections()) {
     SCOPED_TRACE(inj.name);
     auto od = Make(Config(LevelLine()));
-    Stream s(10.0);
+    Stream s;
+    RunUp(*od, s, 10.0);
     CycleInput prev;
     for (int k = 0; k < 50; ++k) {
       prev = s.Next();
@@ -200,6 +203,10 @@ TEST(OdometryInput, EveryReasonGivesTheSafeReaction) {
       EXPECT_TRUE(q.stop_demand);
       EXPECT_FALSE(q.position_valid);
     }
+    const OdometryOutput& moving = od->Step(s.Next({}, {}, std::llround(s.TrueFrontMm())));
+    EXPECT_TRUE(moving.stop_demand);  // a balise while running: not trusted yet
+    EXPECT_EQ(moving.mode, Mode::kStopped);
+    BrakeAndWarmUp(*od, s);
     const std::int64_t fix = std::llround(s.TrueFrontMm()) + 1'000;
     const OdometryOutput& r = od->Step(s.Next({}, {}, fix));
     EXPECT_EQ(r.mode, Mode::kTg);
@@ -212,11 +219,14 @@ TEST(OdometryInput, EveryReasonGivesTheSafeReaction) {
 }
 
 // A TG counter that restarts from 0 (power loss): rejected once, then a new baseline; the
-// position is re-established at the next balise fix (ASM-026).
+// position is re-established at the next balise fix after the warm-up at standstill
+// (ASM-026, REQ-RA-015).
 // @verifies REQ-RA-013
+// @verifies REQ-RA-015
 TEST(OdometryInput, RestartedCounterRecoversAtABalise) {
   auto od = Make(Config(LevelLine()));
-  Stream s(10.0);
+  Stream s;
+  RunUp(*od, s, 10.0);
   for (int k = 0; k < 50; ++k) (void)od->Step(s.Next());
   const std::int64_t offset = s.pulses();
   OdometryOutput o;
@@ -234,6 +244,7 @@ TEST(OdometryInput, RestartedCounterRecoversAtABalise) {
     EXPECT_TRUE(o.stop_demand);
   }
   EXPECT_NEAR(static_cast<double>(o.front_mm - front), 4'000.0, 35.0);  // from the new baseline
+  BrakeAndWarmUp(*od, s, [offset](CycleInput& c) { c.tg.pulses -= offset; });
   in = s.Next({}, {}, std::llround(s.TrueFrontMm()) + 1'000);
   in.tg.pulses -= offset;
   o = od->Step(in);
@@ -247,7 +258,8 @@ TEST(OdometryInput, RestartedCounterRecoversAtABalise) {
 // @verifies REQ-RA-013
 TEST(OdometryInput, GapAndBothSensorsFailing) {
   auto od = Make(Config(LevelLine()));
-  Stream s(10.0);
+  Stream s;
+  RunUp(*od, s, 10.0);
   for (int k = 0; k < 50; ++k) (void)od->Step(s.Next());
   (void)s.Next();  // lost
   OdometryOutput o = od->Step(s.Next());
@@ -257,7 +269,8 @@ TEST(OdometryInput, GapAndBothSensorsFailing) {
   EXPECT_EQ(o.input_error, InputError::kNone);  // the stream continues from the received time
 
   auto od2 = Make(Config(LevelLine()));
-  Stream s2(10.0);
+  Stream s2;
+  RunUp(*od2, s2, 10.0);
   CycleInput prev;
   for (int k = 0; k < 50; ++k) (void)od2->Step(prev = s2.Next());
   CycleInput bad = s2.Next();
@@ -273,7 +286,8 @@ TEST(OdometryInput, GapAndBothSensorsFailing) {
 // @verifies REQ-RA-013
 TEST(OdometryInput, FailureWhileCompensatingDiscardsTheCandidates) {
   auto od = Make(Config(LevelLine()));
-  Stream s(12.0);
+  Stream s;
+  RunUp(*od, s, 12.0);
   OdometryOutput o;
   for (int k = 0; k < 100 && o.mode != Mode::kCompensating; ++k) {
     o = od->Step(s.Next({0.0, k < 60 ? 0.0 : std::min(3.0, 0.3 * (k - 59))}));
@@ -297,7 +311,8 @@ TEST(OdometryInput, FailureWhileCompensatingDiscardsTheCandidates) {
 // @verifies REQ-RA-013
 TEST(OdometryInput, NothingOfARejectedCycleIsUsed) {
   auto od = Make(Config(LevelLine()));
-  Stream s(10.0);
+  Stream s;
+  RunUp(*od, s, 10.0);
   CycleInput prev;
   for (int k = 0; k < 50; ++k) (void)od->Step(prev = s.Next());
   // a rejected cycle with a balise fix: still stopped

@@ -17,6 +17,7 @@
 #include <array>
 #include <cstdint>
 #include <initializer_list>
+#include <utility>
 
 #include "railproof/testing/enum_names.hpp"
 #include "railproof/testing/alloc_counter.hpp"
@@ -34,11 +35,14 @@ constexpr SectionLimits kTight{40, 500};
 constexpr std::int32_t kStartAge = 25;
 constexpr std::int32_t kSpacing = 25;
 
+constexpr std::int32_t kWarmup = static_cast<std::int32_t>((prm::moving_average_ms + prm::tg_window_ms) / prm::cycle_ms);
+
 MachineConfig Config(std::uint8_t points = 2, std::uint8_t confirm = 3) {
   MachineConfig c;
   c.confirm_cycles = confirm;
   c.start_points = points;
   c.spacing_cycles = kSpacing;
+  c.warmup_cycles = kWarmup;
   return c;
 }
 
@@ -56,6 +60,16 @@ Predicates In(bool deviation, SectionLimits s = kNormal, bool sa0 = false, bool 
 const MachineState& Cycle(ReadhesionMachine& m, const Predicates& p) {
   EXPECT_EQ(m.Step(p), MachineError::kNone);
   return m.state();
+}
+
+// A machine past its start-up: the warm-up at standstill (healthy, no TG pulse), after which
+// it is in TG odometry with the history trusted (REQ-RA-015).
+ReadhesionMachine Running(const MachineConfig& c) {
+  ReadhesionMachine m(c);
+  for (int k = 0; k < c.warmup_cycles; ++k) Cycle(m, In(false));
+  EXPECT_EQ(m.state().mode, Mode::kTg);
+  EXPECT_TRUE(m.state().trusted);
+  return m;
 }
 
 // Drives a fresh machine through a detection (confirm_cycles deviations).
@@ -121,15 +135,23 @@ TEST(OdometryReadhesionMachine, ConfigurationValidation) {
     EXPECT_EQ(ReadhesionMachine::Validate(c), k.expected)
         << "points " << int{k.points} << ", confirm " << int{k.confirm} << ", spacing " << k.spacing;
   }
+  for (const auto& [warmup, expected] : {std::pair{0, MachineError::kWarmupInvalid}, std::pair{1, MachineError::kNone},
+                                         std::pair{10000, MachineError::kNone},
+                                         std::pair{10001, MachineError::kWarmupInvalid}}) {
+    MachineConfig c = Config();
+    c.warmup_cycles = warmup;
+    EXPECT_EQ(ReadhesionMachine::Validate(c), expected) << "warmup " << warmup;
+  }
   // the reference configuration (spec/parameters/ra.yaml)
   MachineConfig ref;
   ref.confirm_cycles = static_cast<std::uint8_t>(prm::confirm_cycles);
   ref.start_points = static_cast<std::uint8_t>(prm::parallel_start_points);
   ref.spacing_cycles = static_cast<std::int32_t>(prm::parallel_spacing_ms / prm::cycle_ms);
+  ref.warmup_cycles = kWarmup;
   EXPECT_EQ(ReadhesionMachine::Validate(ref), MachineError::kNone);
   EXPECT_EQ(ref.spacing_cycles, kSpacing);
   for (MachineError e : {MachineError::kNone, MachineError::kConfirmCyclesInvalid, MachineError::kStartPointsInvalid,
-                         MachineError::kSpacingInvalid, MachineError::kSectionInvalid,
+                         MachineError::kSpacingInvalid, MachineError::kWarmupInvalid, MachineError::kSectionInvalid,
                          MachineError::kStartAgeInvalid}) {
     EXPECT_STRNE(ToString(e), "unknown");
   }
@@ -141,15 +163,16 @@ TEST(OdometryReadhesionMachine, ConfigurationValidation) {
 // @verifies REQ-RA-013
 TEST(OdometryReadhesionMachine, NamesOfTheVectors) {
   railproof::testing::ExpectEnumNames<Mode>(std::array<const char*, 3>{"TG", "COMPENSATING", "STOPPED"});
-  railproof::testing::ExpectEnumNames<StopReason>(std::array<const char*, 4>{"NONE", "MAX_COMPENSATION_TIME", "IMU_FAILURE", "TG_FAILURE"});
+  railproof::testing::ExpectEnumNames<StopReason>(std::array<const char*, 6>{
+      "NONE", "MAX_COMPENSATION_TIME", "IMU_FAILURE", "TG_FAILURE", "START_UP", "START_IN_MOTION"});
 }
 
-// Steps 1 and 4: a fresh machine is in TG odometry with a valid position; the first cycle
-// takes the section's limits; deviations below confirm_cycles only count.
+// Steps 1 and 4: after the warm-up the machine is in TG odometry with a valid position; each
+// cycle takes the section's limits; deviations below confirm_cycles only count.
 // @verifies REQ-RA-003
 // @verifies REQ-RA-009
-TEST(OdometryReadhesionMachine, StartsInTgOdometryAndTakesTheSectionLimits) {
-  ReadhesionMachine m(Config());
+TEST(OdometryReadhesionMachine, AfterTheWarmUpInTgOdometryWithTheSectionLimits) {
+  ReadhesionMachine m = Running(Config());
   EXPECT_EQ(m.state().mode, Mode::kTg);
   EXPECT_TRUE(m.state().position_valid);
   EXPECT_FALSE(m.state().stop_demand);
@@ -167,7 +190,7 @@ TEST(OdometryReadhesionMachine, StartsInTgOdometryAndTakesTheSectionLimits) {
 // @verifies REQ-RA-009
 // @verifies REQ-RA-004
 TEST(OdometryReadhesionMachine, InvalidInputsRejectedWithoutChange) {
-  ReadhesionMachine m(Config());
+  ReadhesionMachine m = Running(Config());
   Cycle(m, In(true));
   Predicates bad = In(true, SectionLimits{0, 1000});
   EXPECT_EQ(m.Step(bad), MachineError::kSectionInvalid);
@@ -191,7 +214,7 @@ TEST(OdometryReadhesionMachine, InvalidInputsRejectedWithoutChange) {
 // @verifies REQ-RA-003
 // @verifies REQ-RA-010
 TEST(OdometryReadhesionMachine, DetectionAfterConfirmCyclesWithTwoStartPoints) {
-  ReadhesionMachine m(Config());
+  ReadhesionMachine m = Running(Config());
   Cycle(m, In(true));
   Cycle(m, In(true));
   EXPECT_EQ(m.state().deviation_count, 2);
@@ -220,7 +243,7 @@ TEST(OdometryReadhesionMachine, DetectionAfterConfirmCyclesWithTwoStartPoints) {
 // @verifies REQ-RA-003
 // @verifies REQ-RA-010
 TEST(OdometryReadhesionMachine, OneStartPointStartsOneCandidate) {
-  ReadhesionMachine m(Config(1));
+  ReadhesionMachine m = Running(Config(1));
   const MachineState& s = Detect(m);
   EXPECT_EQ(s.mode, Mode::kCompensating);
   EXPECT_TRUE(s.candidates[0].active);
@@ -233,7 +256,7 @@ TEST(OdometryReadhesionMachine, OneStartPointStartsOneCandidate) {
 // @verifies REQ-RA-003
 // @verifies REQ-RA-006
 TEST(OdometryReadhesionMachine, ConfirmationOfOneCycle) {
-  ReadhesionMachine m(Config(2, 1));
+  ReadhesionMachine m = Running(Config(2, 1));
   EXPECT_EQ(Cycle(m, In(true)).mode, Mode::kCompensating);
   const MachineState& s = Judge(m, true, false);
   EXPECT_EQ(s.mode, Mode::kTg);
@@ -245,17 +268,17 @@ TEST(OdometryReadhesionMachine, ConfirmationOfOneCycle) {
 // @verifies REQ-RA-007
 // @verifies REQ-RA-010
 TEST(OdometryReadhesionMachine, StartPointsOlderThanTmaxDiscardedAtDetection) {
-  ReadhesionMachine m(Config());
+  ReadhesionMachine m = Running(Config());
   const MachineState& s = Detect(m, kTight);  // 25 <= 40 < 50
   EXPECT_EQ(s.mode, Mode::kCompensating);
   EXPECT_TRUE(s.candidates[0].active);
   EXPECT_FALSE(s.candidates[1].active);
   EXPECT_EQ(s.candidates[1].age_cycles, 0);
 
-  ReadhesionMachine edge(Config());
+  ReadhesionMachine edge = Running(Config());
   EXPECT_TRUE(Detect(edge, kTight, 40).candidates[0].active);  // exactly t_max: kept
 
-  ReadhesionMachine old(Config());
+  ReadhesionMachine old = Running(Config());
   const MachineState& t = Detect(old, kTight, 41);
   EXPECT_TRUE(t.detected);
   ExpectStopped(t, StopReason::kMaxCompensationTime);
@@ -266,7 +289,7 @@ TEST(OdometryReadhesionMachine, StartPointsOlderThanTmaxDiscardedAtDetection) {
 // discarded; when it was the last, the stop demand and the invalid position in that cycle.
 // @verifies REQ-RA-007
 TEST(OdometryReadhesionMachine, TimeoutAtTmaxPlusOne) {
-  ReadhesionMachine m(Config());
+  ReadhesionMachine m = Running(Config());
   Detect(m, kTight);
   for (std::int32_t age = kStartAge + 1; age <= kTight.max_compensation_cycles; ++age) {
     const MachineState& s = Cycle(m, In(true, kTight));
@@ -285,7 +308,7 @@ TEST(OdometryReadhesionMachine, TimeoutAtTmaxPlusOne) {
 // @verifies REQ-RA-010
 TEST(OdometryReadhesionMachine, SecondStartPointTimesOutPrimaryContinues) {
   const SectionLimits s60{60, 1000};
-  ReadhesionMachine m(Config());
+  ReadhesionMachine m = Running(Config());
   Detect(m, s60);
   for (int k = 0; k < 10; ++k) {
     Cycle(m, In(true, s60));
@@ -304,7 +327,7 @@ TEST(OdometryReadhesionMachine, SecondStartPointTimesOutPrimaryContinues) {
 // @verifies REQ-RA-006
 // @verifies REQ-RA-010
 TEST(OdometryReadhesionMachine, ReadhesionAfterConfirmCycles) {
-  ReadhesionMachine m(Config());
+  ReadhesionMachine m = Running(Config());
   Detect(m);
   EXPECT_EQ(Judge(m, true, false).candidates[0].confirm, 1);
   const MachineState& two = Judge(m, true, false);
@@ -323,7 +346,7 @@ TEST(OdometryReadhesionMachine, ReadhesionAfterConfirmCycles) {
 // The speed condition alone failing restarts the confirmation.
 // @verifies REQ-RA-006
 TEST(OdometryReadhesionMachine, SpeedDisagreementRestartsTheConfirmation) {
-  ReadhesionMachine m(Config(1));
+  ReadhesionMachine m = Running(Config(1));
   Detect(m);
   Judge(m, true, false);
   Judge(m, true, false);
@@ -339,7 +362,7 @@ TEST(OdometryReadhesionMachine, SpeedDisagreementRestartsTheConfirmation) {
 // A deviation restarts the confirmation of every candidate, even with the speeds agreeing.
 // @verifies REQ-RA-006
 TEST(OdometryReadhesionMachine, DeviationRestartsTheConfirmation) {
-  ReadhesionMachine m(Config());
+  ReadhesionMachine m = Running(Config());
   DetectThenJudge(m, {{true, true}, {true, true}});
   const MachineState& s = Cycle(m, In(true, kNormal, true, true));
   EXPECT_EQ(s.mode, Mode::kCompensating);
@@ -350,14 +373,14 @@ TEST(OdometryReadhesionMachine, DeviationRestartsTheConfirmation) {
 // Both complete the confirmation in the same cycle: the primary (lowest index) wins.
 // @verifies REQ-RA-010
 TEST(OdometryReadhesionMachine, BothConfirmInOneCyclePrimaryAdopted) {
-  ReadhesionMachine m(Config());
+  ReadhesionMachine m = Running(Config());
   ExpectAdopted(DetectThenJudge(m, {{true, true}, {true, true}, {true, true}}), 0);
 }
 
 // The second start point completes first (the primary one cycle short) and is adopted.
 // @verifies REQ-RA-010
 TEST(OdometryReadhesionMachine, SecondStartPointAdoptedWhenFirst) {
-  ReadhesionMachine m(Config());
+  ReadhesionMachine m = Running(Config());
   ExpectAdopted(DetectThenJudge(m, {{false, true}, {true, true}, {true, true}}), 1);
 }
 
@@ -365,7 +388,7 @@ TEST(OdometryReadhesionMachine, SecondStartPointAdoptedWhenFirst) {
 // odometry (and from the first cycle after the episode) the limits follow the section.
 // @verifies REQ-RA-009
 TEST(OdometryReadhesionMachine, EpisodeNeverRelaxesItsLimits) {
-  ReadhesionMachine m(Config());
+  ReadhesionMachine m = Running(Config());
   Cycle(m, In(false, kSteep));
   EXPECT_EQ(Cycle(m, In(false, kNormal)).margin_mm, 1000);  // TG odometry: the current section
   Detect(m, kNormal);
@@ -397,7 +420,7 @@ TEST(OdometryReadhesionMachine, EpisodeNeverRelaxesItsLimits) {
 // @verifies REQ-RA-009
 // @verifies REQ-RA-007
 TEST(OdometryReadhesionMachine, TightSectionTimesOutTheEpisode) {
-  ReadhesionMachine m(Config());
+  ReadhesionMachine m = Running(Config());
   Detect(m);
   for (int k = 0; k < 15; ++k) {
     Cycle(m, In(true));
@@ -411,7 +434,7 @@ TEST(OdometryReadhesionMachine, TightSectionTimesOutTheEpisode) {
 // @verifies REQ-RA-013
 TEST(OdometryReadhesionMachine, SensorFailureInEveryMode) {
   {  // TG odometry, IMU
-    ReadhesionMachine m(Config());
+    ReadhesionMachine m = Running(Config());
     Cycle(m, In(true));
     Predicates p = In(true);
     p.imu_ok = false;
@@ -420,13 +443,13 @@ TEST(OdometryReadhesionMachine, SensorFailureInEveryMode) {
     EXPECT_EQ(s.deviation_count, 0);
   }
   {  // TG odometry, TG
-    ReadhesionMachine m(Config());
+    ReadhesionMachine m = Running(Config());
     Predicates p = In(false);
     p.tg_ok = false;
     ExpectStopped(Cycle(m, p), StopReason::kTgFailure);
   }
   {  // compensating, TG: every candidate discarded
-    ReadhesionMachine m(Config());
+    ReadhesionMachine m = Running(Config());
     Detect(m);
     Predicates p = In(false, kNormal, true, true);
     p.tg_ok = false;
@@ -437,7 +460,7 @@ TEST(OdometryReadhesionMachine, SensorFailureInEveryMode) {
     EXPECT_EQ(s.adopted, kNoCandidate);
   }
   {  // compensating, IMU
-    ReadhesionMachine m(Config());
+    ReadhesionMachine m = Running(Config());
     Detect(m);
     Predicates p = In(false);
     p.imu_ok = false;
@@ -446,7 +469,7 @@ TEST(OdometryReadhesionMachine, SensorFailureInEveryMode) {
     EXPECT_FALSE(s.candidates[0].active);
   }
   {  // stopped after a timeout: the reason becomes the failure; both failing: IMU
-    ReadhesionMachine m(Config());
+    ReadhesionMachine m = Running(Config());
     Detect(m, kTight, 41);
     EXPECT_EQ(m.state().stop_reason, StopReason::kMaxCompensationTime);
     Predicates p = In(false);
@@ -465,7 +488,7 @@ TEST(OdometryReadhesionMachine, SensorFailureInEveryMode) {
 // @verifies REQ-RA-012
 // @verifies REQ-RA-013
 TEST(OdometryReadhesionMachine, StoppedHeldUntilABalise) {
-  ReadhesionMachine m(Config());
+  ReadhesionMachine m = Running(Config());
   Detect(m, kTight, 41);
   for (int k = 0; k < 3; ++k) {
     const MachineState& s = Cycle(m, In(true));
@@ -480,6 +503,12 @@ TEST(OdometryReadhesionMachine, StoppedHeldUntilABalise) {
   EXPECT_FALSE(failing.balise_reset);
   p.tg_ok = true;
   p.deviation = true;
+  // a balise before the warm-up at standstill after the stop: still stopped (REQ-RA-015)
+  ExpectStopped(Cycle(m, p), StopReason::kTgFailure);
+  EXPECT_FALSE(m.state().trusted);
+  EXPECT_FALSE(m.state().balise_reset);
+  for (int k = 0; k < kWarmup; ++k) ExpectStopped(Cycle(m, In(false)), StopReason::kTgFailure);
+  EXPECT_TRUE(m.state().trusted);
   const MachineState& s = Cycle(m, p);
   EXPECT_EQ(s.mode, Mode::kTg);
   EXPECT_EQ(s.stop_reason, StopReason::kNone);
@@ -489,12 +518,107 @@ TEST(OdometryReadhesionMachine, StoppedHeldUntilABalise) {
   EXPECT_EQ(s.deviation_count, 0);  // the recovery cycle's deviation does not count
 }
 
+// Step 2a (REQ-RA-015): a fresh machine is stopped at start-up, the stop demand and the
+// position invalid, until warmup_cycles healthy cycles without a TG pulse; the start-up
+// then ends without a balise, in the cycle the warm-up completes.
+// @verifies REQ-RA-015
+TEST(OdometryReadhesionMachine, StartUpEndsWithTheWarmUpAtStandstill) {
+  ReadhesionMachine m(Config());
+  ExpectStopped(m.state(), StopReason::kStartUp);
+  EXPECT_FALSE(m.state().trusted);
+  for (int k = 1; k < kWarmup; ++k) {
+    ExpectStopped(Cycle(m, In(false)), StopReason::kStartUp);
+    EXPECT_EQ(m.state().rest_cycles, k);
+  }
+  const MachineState& s = Cycle(m, In(false));
+  EXPECT_EQ(s.mode, Mode::kTg);
+  EXPECT_EQ(s.stop_reason, StopReason::kNone);
+  EXPECT_TRUE(s.position_valid);
+  EXPECT_FALSE(s.stop_demand);
+  EXPECT_TRUE(s.trusted);
+  EXPECT_FALSE(s.balise_reset);
+}
+
+// A TG pulse before the warm-up is complete: a start in motion. The warm-up restarts; once
+// trusted the stop is held until a balise (boundary: the pulse in the last cycle before the
+// warm-up would complete).
+// @verifies REQ-RA-015
+TEST(OdometryReadhesionMachine, StartInMotionNeedsTheWarmUpAndABalise) {
+  ReadhesionMachine m(Config());
+  for (int k = 1; k < kWarmup; ++k) Cycle(m, In(false));
+  EXPECT_EQ(m.state().rest_cycles, kWarmup - 1);
+  Predicates moving = In(false);
+  moving.tg_moving = true;
+  ExpectStopped(Cycle(m, moving), StopReason::kStartInMotion);
+  EXPECT_EQ(m.state().rest_cycles, 0);
+  Predicates bal = In(false);
+  bal.balise = true;
+  ExpectStopped(Cycle(m, bal), StopReason::kStartInMotion);  // not trusted yet
+  EXPECT_FALSE(m.state().balise_reset);
+  for (int k = 1; k < kWarmup; ++k) ExpectStopped(Cycle(m, In(false)), StopReason::kStartInMotion);
+  EXPECT_TRUE(m.state().trusted);
+  ExpectStopped(Cycle(m, moving), StopReason::kStartInMotion);  // trusted: moving to a balise
+  const MachineState& s = Cycle(m, bal);
+  EXPECT_EQ(s.mode, Mode::kTg);
+  EXPECT_TRUE(s.position_valid);
+  EXPECT_TRUE(s.balise_reset);
+}
+
+// While a stop waits for its balise with the history trusted, confirm_cycles deviations in a
+// row withdraw the trust (a TG wheel locked through the "standstill" that rolls again); one
+// fewer does not (boundary). A new warm-up at standstill is needed before the balise.
+// @verifies REQ-RA-015
+TEST(OdometryReadhesionMachine, DeviationRunWhileWaitingWithdrawsTheTrust) {
+  ReadhesionMachine m = Running(Config());
+  Detect(m, kTight, 41);
+  for (int k = 0; k < kWarmup; ++k) Cycle(m, In(false));
+  ASSERT_TRUE(m.state().trusted);
+  for (int k = 1; k < m.config().confirm_cycles; ++k) Cycle(m, In(true));
+  EXPECT_TRUE(Cycle(m, In(false)).trusted);  // confirm_cycles - 1, then none: kept
+  for (int k = 1; k < m.config().confirm_cycles; ++k) EXPECT_TRUE(Cycle(m, In(true)).trusted);
+  const MachineState& s = Cycle(m, In(true));
+  ExpectStopped(s, StopReason::kMaxCompensationTime);
+  EXPECT_FALSE(s.trusted);
+  EXPECT_EQ(s.deviation_count, 0);
+  Predicates bal = In(false);
+  bal.balise = true;
+  ExpectStopped(Cycle(m, bal), StopReason::kMaxCompensationTime);  // trust withdrawn: held
+  for (int k = 0; k < kWarmup; ++k) Cycle(m, In(false));
+  EXPECT_EQ(Cycle(m, bal).mode, Mode::kTg);
+}
+
+// Every stop withdraws the trust: after a timeout a balise counts only after a new warm-up
+// at standstill; a sensor failure during the start-up makes it a failure stop (a balise).
+// @verifies REQ-RA-015
+// @verifies REQ-RA-007
+TEST(OdometryReadhesionMachine, EveryStopNeedsANewWarmUp) {
+  ReadhesionMachine m = Running(Config());
+  Detect(m, kTight, 41);
+  ExpectStopped(m.state(), StopReason::kMaxCompensationTime);
+  EXPECT_FALSE(m.state().trusted);
+  Predicates bal = In(false);
+  bal.balise = true;
+  bal.tg_moving = true;
+  ExpectStopped(Cycle(m, bal), StopReason::kMaxCompensationTime);
+  for (int k = 0; k < kWarmup; ++k) Cycle(m, In(false));
+  EXPECT_EQ(Cycle(m, bal).mode, Mode::kTg);
+
+  ReadhesionMachine f(Config());
+  Predicates failed = In(false);
+  failed.imu_ok = false;
+  ExpectStopped(Cycle(f, failed), StopReason::kImuFailure);
+  for (int k = 0; k < kWarmup; ++k) ExpectStopped(Cycle(f, In(false)), StopReason::kImuFailure);
+  EXPECT_TRUE(f.state().trusted);
+  bal.tg_moving = false;
+  EXPECT_EQ(Cycle(f, bal).mode, Mode::kTg);
+}
+
 // Step 4/5: a balise in TG odometry resets the accumulated error (and does not break a
 // run of deviations); while compensating it does not reset and the compensation goes on.
 // @verifies REQ-RA-012
 // @verifies REQ-RA-003
 TEST(OdometryReadhesionMachine, BaliseResetsInTgOdometryOnly) {
-  ReadhesionMachine m(Config());
+  ReadhesionMachine m = Running(Config());
   Predicates p = In(false);
   p.balise = true;
   EXPECT_TRUE(Cycle(m, p).balise_reset);
@@ -513,7 +637,7 @@ TEST(OdometryReadhesionMachine, BaliseResetsInTgOdometryOnly) {
 
 // The cycle allocates nothing (runtime rules: no heap after construction).
 TEST(OdometryReadhesionMachine, StepAllocatesNothing) {
-  ReadhesionMachine m(Config());
+  ReadhesionMachine m = Running(Config());
   railproof::testing::StartCountingAllocations();
   Detect(m);
   for (int k = 0; k < 300; ++k) {

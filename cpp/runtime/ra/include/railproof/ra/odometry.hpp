@@ -97,9 +97,10 @@ struct OdometryConfig {
   std::uint8_t start_points = static_cast<std::uint8_t>(params::ra::parallel_start_points);
   std::int64_t imu_rate_error_udeg_s = params::ra::imu_rate_error_udeg_s;
   std::int64_t length_correction_ppm = 1000;  // accumulated TG error (REQ-MB-002)
-  // baseline method (max/min acceleration) only: vehicle bounds
-  std::int64_t accel_max_mm_s2 = 920;
-  std::int64_t decel_max_mm_s2 = 1400;
+  // baseline method (max/min acceleration) only: vehicle bounds, by default D1's figures
+  // (3.3 and 5.2 km/h/s) rounded up to mm/s^2 (the wider envelope)
+  std::int64_t accel_max_mm_s2 = (params::ra::former_accel_max_kmh_s_x10 * 1000 + 35) / 36;
+  std::int64_t decel_max_mm_s2 = (params::ra::former_decel_max_kmh_s_x10 * 1000 + 35) / 36;
   const OdometrySection* sections = nullptr;  // copied at Create, ordered, contiguous
   int section_count = 0;
   std::int64_t initial_front_mm = 0;          // front at the first cycle (initial balise fix)
@@ -251,6 +252,7 @@ class Odometry {
   [[nodiscard]] Limits SectionLimitsAt(std::int64_t front_mm, std::int64_t extension_mm) const noexcept;
   [[nodiscard]] std::int64_t StartPoint(std::int64_t detection) const noexcept;
   void InitCandidate(CandidateState& c, std::int64_t start, bool slip) const noexcept;
+  void BaselineAccelerations(CandidateState& c, bool slip) const noexcept;
   void AdvanceCandidate(CandidateState& c, const HistoryEntry& e) const noexcept;
   [[nodiscard]] double CandidateFrontUm(const CandidateState& c) const noexcept;
   void Record(std::size_t c, HistoryEntry& e) const noexcept;

@@ -37,8 +37,8 @@ using namespace ::railproof::offline;  // NOLINT(google-build-using-namespace)
 
 // ---- error model, baseline, clearing time (D1 §3 items 6, 7, 9) ------------------------
 
-// Vehicle figures of the former method (D1 §3 item 9: acceleration 0.58-0.92 m/s^2,
-// deceleration 0.97-1.4 m/s^2).
+// Vehicle figures of the former method (D1 §3 item 9, in km/h/s: acceleration 2.1-3.3,
+// deceleration 3.5-5.2; spec/parameters/ra.yaml former_*), in m/s^2.
 struct VehicleAccelBounds {
   double accel_min = 0.0;  // m/s^2, lowest traction acceleration on the level
   double accel_max = 0.0;  // m/s^2, highest traction acceleration on the level
@@ -67,8 +67,9 @@ struct VehicleAccelBounds {
 // start point (position x0, speed v0) the front is advanced with the upper acceleration
 // bound a_f and the rear with the lower bound a_r, so the occupied range grows by
 // (a_f - a_r) t^2 / 2 (v0 high enough that the rear bound does not reach standstill, the
-// worst case). With G_g = G g/1000 for the steepest gradient magnitude g:
-//   slip            a_f = accel_max + G_g (falling gradient), a_r = accel_min - G_g (rising)
+// worst case). With G_g = G g/1000 for the steepest gradient magnitude g (D1 §3.4.3):
+//   slip            a_f = accel_max + G_g (falling gradient), a_r = -G_g (the minimum
+//                   acceleration including coasting: coasting on the rising gradient)
 //   slide           a_f = +G_g (least deceleration incl. coasting on the falling gradient),
 //                   a_r = -(decel_max + G_g) (most deceleration on the rising gradient)
 //   slide (braked)  a_f = -decel_min + G_g (the brake known to act: least braking deceleration)

@@ -232,6 +232,31 @@ struct ScenarioOdometry {
   std::optional<std::int64_t> rate_error_udeg_s;       // error model's IMU rate error (parameter 2500)
 };
 
+// How a scenario begins for the odometry (REQ-RA-015: the odometry trusts its TG history
+// only after a warm-up at standstill):
+//   kAtRest   the train stands at t = 0 (initial speed 0); the odometry starts with the run
+//   kLeadIn   the train runs at the initial speed at t = 0; the simulator first runs a lead-in
+//             from rest (LeadInSpec), so that the odometry has warmed up at standstill and
+//             run with the train up to the scenario's start
+//   kInMotion the odometry starts with the run, in motion: the start-up case, which the
+//             odometry must treat as a start in motion (no valid position)
+enum class ScenarioStart : std::uint8_t { kAtRest, kLeadIn, kInMotion };
+const char* ToString(ScenarioStart s);  // "at_rest", "lead_in", "in_motion"
+
+// The lead-in of a kLeadIn scenario: standstill (brake applied) for standstill_s, then a
+// speed ramp at accel_mps2 up to the initial speed, held for hold_s; the train starts at
+// rest so far back that the front reaches initial_front_m at the end, where the scenario's
+// t = 0 begins (the first cycle boundary at or after it). The first gradient of the
+// alignment is extended backwards over the lead-in; its rail has no adhesion zone.
+struct LeadInSpec {
+  double standstill_s = 5.0;  // longer than the odometry's warm-up (4 s)
+  double accel_mps2 = 0.3;
+  double hold_s = 15.0;
+  double traction_cap = 0.6;  // notch fractions of the speed controller
+  double brake_cap = 0.6;
+};
+[[nodiscard]] double LeadInDistanceM(const LeadInSpec& lead, double speed_mps);
+
 struct WheelRailScenario {
   std::string file;
   std::string name;
@@ -243,6 +268,8 @@ struct WheelRailScenario {
   std::uint64_t seed = 1;
   double initial_front_m = 0.0;           // line chainage of the front at t = 0
   double initial_speed_kmh = 0.0;
+  ScenarioStart start = ScenarioStart::kAtRest;
+  LeadInSpec lead_in;                     // kLeadIn only
   VerticalAlignment vertical;
   std::vector<HorizontalCurve> curves;
   RailCondition rail;
@@ -325,7 +352,8 @@ struct WheelRailRun {
   std::vector<ra::CycleInput> cycles;  // one per 100 ms, time_ms = 100, 200, ... (faults aside)
   std::vector<TruthCycle> truth;             // one per cycle, same index
   std::vector<SlipEvent> events;             // sorted by start, then axle
-  double simulated_s = 0.0;
+  double simulated_s = 0.0;                  // the lead-in included
+  std::int64_t lead_in_ms = 0;               // kLeadIn: the run's time of the scenario's t = 0
   std::uint64_t steps = 0;                   // Box2D steps
   double pulse_length_m = 0.0;               // true pulse length of the TG wheel
 };
