@@ -47,7 +47,7 @@ class ParsePosition {
   void Open(bool object) {
     BeginValue();
     if (frames_.size() >= kMaxJsonDepth) {
-      throw StopParse{"nesting deeper than " + std::to_string(kMaxJsonDepth) + " levels at " + Path()};
+      throw StopParse{"nesting deeper than " + std::to_string(kMaxJsonDepth) + " levels at " + Quoted(Path())};
     }
     frames_.push_back(Frame{object, {}, {}, 0, false});
   }
@@ -56,7 +56,7 @@ class ParsePosition {
     Frame& f = frames_.back();
     f.key = key;
     if (!f.keys.insert(key).second) {
-      throw StopParse{"duplicate key \"" + Path() + "\""};
+      throw StopParse{"duplicate key " + Quoted(Path())};
     }
   }
 
@@ -109,6 +109,12 @@ bool IsLowerHex(const json& v, std::size_t digits) {
 }
 
 }  // namespace
+
+std::string Quoted(std::string_view s) {
+  const bool cut = s.size() > kMaxQuoted;
+  const json text = std::string(s.substr(0, kMaxQuoted));
+  return text.dump(-1, ' ', false, json::error_handler_t::replace) + (cut ? " (cut)" : "");
+}
 
 std::string Sha256Hex(std::string_view bytes) {
   std::array<unsigned char, crypto_hash_sha256_BYTES> digest{};
@@ -202,7 +208,7 @@ std::string ReadVectorFile(const std::string& file, std::string_view text, const
                      std::to_string(kVectorSchemaVersion) + ")");
   }
   if (const std::string k = UnknownKey(header, WithCommonHeaderKeys(keys.header)); !k.empty()) {
-    return at(1, "unknown header key \"" + k + "\"");
+    return at(1, "unknown header key " + Quoted(k));
   }
   const json* count = header.contains("vector_count") ? &header["vector_count"] : nullptr;
   if (count == nullptr || !count->is_number_integer() || *count < 0) {
@@ -243,7 +249,7 @@ std::string ReadVectorFile(const std::string& file, std::string_view text, const
       return at(n, "the line is not a JSON object");
     }
     if (const std::string k = UnknownKey(v.obj, vector_keys); !k.empty()) {
-      return at(n, "unknown key \"" + k + "\"");
+      return at(n, "unknown key " + Quoted(k));
     }
     out.vectors.push_back(std::move(v));
   }

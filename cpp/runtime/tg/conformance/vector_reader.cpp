@@ -106,14 +106,14 @@ T OneOf(const json& object, const char* key, const std::string& where,
       return result;
     }
   }
-  throw FormatError("field \"" + Name(where, key) + "\" has unknown value \"" + value + "\"");
+  throw FormatError("field \"" + Name(where, key) + "\" has unknown value " + Quoted(value));
 }
 
 void OnlyKeys(const json& object, const std::string& where, std::initializer_list<const char*> allowed) {
   for (auto it = object.begin(); it != object.end(); ++it) {
     const std::string& key = it.key();
     if (std::none_of(allowed.begin(), allowed.end(), [&key](const char* a) { return key == a; })) {
-      throw FormatError("unknown field \"" + Name(where, key.c_str()) + "\"");
+      throw FormatError("unknown field " + Quoted(Name(where, key.c_str())));
     }
   }
 }
@@ -171,12 +171,12 @@ Step ParseStep(const json& step, std::size_t index, rr::Role role) {
     const std::string verdict = String(out, "verdict", wout);
     const auto parsed = ParseVerdict(verdict);
     if (!parsed) {
-      throw FormatError("field \"" + wout + ".verdict\" has unknown value \"" + verdict + "\"");
+      throw FormatError("field \"" + wout + ".verdict\" has unknown value " + Quoted(verdict));
     }
     s.out.verdict = *parsed;
     s.out.gap = U32(out, "gap", wout);
   } else {
-    throw FormatError("field \"" + win + ".ev\" has unknown value \"" + ev + "\"");
+    throw FormatError("field \"" + win + ".ev\" has unknown value " + Quoted(ev));
   }
   s.out.link = ParseLink(out, wout);
   ParseRoleOutputs(out, wout, role, s.out);

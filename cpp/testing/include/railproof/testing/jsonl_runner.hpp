@@ -104,7 +104,7 @@ inline int RunJsonVectors(const JsonRunner& r, int argc, char** argv) {
               if (r.step_ok) {
                 for (std::size_t k = 0; k < steps.size(); ++k) {
                   if (!r.step_ok(line.file, steps[k])) {
-                    return "malformed step " + std::to_string(k) + " in vector " + line.id;
+                    return "malformed step " + std::to_string(k) + " in vector " + Quoted(line.id);
                   }
                 }
               }

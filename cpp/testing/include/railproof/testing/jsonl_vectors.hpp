@@ -79,7 +79,7 @@ inline std::string ReadVectorDirectory(
         VectorLineRef v{name, where, Sanitize(f.stem().string() + "_" + obj["id"].get<std::string>()),
                         obj["id"].get<std::string>(), line.line, &obj};
         if (!names.insert(v.test_name).second) {
-          return where + ": duplicate vector id " + v.id;
+          return where + ": duplicate vector id " + Quoted(v.id);
         }
         if (std::string e = on_vector(v); !e.empty()) {
           return where + ": " + e;

@@ -58,11 +58,16 @@ struct VectorFile {
   std::vector<VectorLine> vectors;
 };
 
+// s as a JSON string (quoted, control characters escaped: a message stays one line), at most
+// kMaxQuoted of its bytes.
+inline constexpr std::size_t kMaxQuoted = 120;
+std::string Quoted(std::string_view s);
+
 // SHA-256 of bytes in lowercase hex (libsodium).
 std::string Sha256Hex(std::string_view bytes);
 
-// Parses one JSON text into out; "" or the reason: malformed JSON, a key named twice in one
-// object (`duplicate key "steps[2].in.v_s"`), nesting deeper than kMaxJsonDepth.
+// Parses one JSON text into out; "" or the one-line reason: malformed JSON, a key named twice
+// in one object (`duplicate key "steps[2].in.v_s"`), nesting deeper than kMaxJsonDepth.
 std::string ParseJsonLine(std::string_view text, nlohmann::json& out);
 
 // "" or the path of the first key of value that keys does not allow ("steps[3].in.speed";
