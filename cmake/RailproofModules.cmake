@@ -208,6 +208,46 @@ function(railproof_conformance cap)
     PASS_REGULAR_EXPRESSION "${prog}: error: vector directory .* does not exist")
   set_tests_properties(conformance_${cap}_rejects_empty_dir PROPERTIES LABELS "conformance;${cap}"
     PASS_REGULAR_EXPRESSION "${prog}: error: no \\*\\.jsonl vector file")
+  # A test report that cannot be written (its directory is a file) is refused before the run.
+  set(expect_script ${RAILPROOF_SOURCE_DIR}/cpp/testing/conformance_expect.cmake)
+  add_test(NAME conformance_${cap}_rejects_unwritable_report
+           COMMAND ${CMAKE_COMMAND} -DRUNNER=$<TARGET_FILE:${exe}> -DPROG=${prog} -DDIR=${RAILPROOF_EMPTY_VECTOR_DIR}
+                   -DEXTRA=--junit=${CMAKE_CURRENT_LIST_FILE}/report.xml -DEXIT=2
+                   "-DEXPECT=cannot write the test report .*/report.xml: Not a directory$" -P ${expect_script})
+  set_tests_properties(conformance_${cap}_rejects_unwritable_report PROPERTIES LABELS "conformance;${cap}")
+  # Small sets made from the build's vectors (cpp/testing/damaged_vector_sets.py): the whole
+  # one passes, each damaged one is refused with exit 1 and its one-line reason.
+  set(damaged ${CMAKE_CURRENT_BINARY_DIR}/damaged_vector_sets)
+  add_test(NAME conformance_${cap}_damaged_sets
+           COMMAND ${CMAKE_COMMAND} -E env ${RAILPROOF_PY_ENV} ${RAILPROOF_PYTHON}
+                   ${RAILPROOF_SOURCE_DIR}/cpp/testing/damaged_vector_sets.py
+                   --vectors ${RAILPROOF_CONFORMANCE_VECTORS} --prefix ${cap} --out ${damaged})
+  set_tests_properties(conformance_${cap}_damaged_sets PROPERTIES LABELS "conformance;${cap}"
+    FIXTURES_SETUP conformance_${cap}_damaged)
+  set(file "${cap}\\.jsonl")
+  foreach(case_expect
+      "whole|0|${prog}: all 2 vectors passed \\(2 in the set\\)"
+      "truncated|1|${file}:1: the header states 2 vectors, the file has 1$"
+      "changed_vector|1|${file}:1: the vector lines do not match the header.s vectors_sha256"
+      "schema_version|1|${file}:1: schema_version 1 is not supported \\(expected 2\\)$"
+      "unknown_header_key|1|${file}:1: unknown header key .unknown_field.$"
+      "unknown_step_key|1|${file}:2: unknown key .steps\\[0\\]\\.(in\\.)?unknown_input.$"
+      "duplicate_key|1|${file}:2: duplicate key .steps\\[0\\]\\.[^ ]+$"
+      "empty_file|1|${file}:1: empty file \\(no header line\\)$"
+      "bad_header|1|${file}:1: malformed JSON: ")
+    string(REPLACE "|" ";" parts "${case_expect}")
+    list(GET parts 0 case)
+    list(GET parts 1 status)
+    list(GET parts 2 expect)
+    set(name conformance_${cap}_rejects_${case})
+    if(case STREQUAL "whole")
+      set(name conformance_${cap}_accepts_whole_small_set)
+    endif()
+    add_test(NAME ${name}
+             COMMAND ${CMAKE_COMMAND} -DRUNNER=$<TARGET_FILE:${exe}> -DPROG=${prog} -DDIR=${damaged}/${case}
+                     -DEXIT=${status} "-DEXPECT=${expect}" -P ${expect_script})
+    set_tests_properties(${name} PROPERTIES LABELS "conformance;${cap}" FIXTURES_REQUIRED conformance_${cap}_damaged)
+  endforeach()
   _railproof_has_faults("${cap}" faults)
   if(faults)
     _railproof_faulty(flinks ${links})

@@ -28,9 +28,16 @@ requirements a run shows, the header, the vector ids and any rule of its own (cl
   (a header, then the vectors), each line checked against spec/schemas/vectors_<cap>.schema.json
   before anything is written; every file written atomically; files of configurations no
   longer generated are removed.
+- Whole or rejected: the header states the number of vector lines (vector_count) and the
+  SHA-256 of the text after the header line, the vector lines exactly as written, each with
+  its newline (vectors_sha256); a file cut at a line boundary, a line dropped, duplicated or
+  edited no longer matches its header (check_seal; the conformance runners check the same,
+  cpp/testing/include/railproof/testing/vector_file.hpp). The header format
+  (spec/schemas/vector_header.schema.json) has the version SCHEMA_VERSION.
 """
 from __future__ import annotations
 
+import hashlib
 import importlib
 import json
 from abc import ABC, abstractmethod
@@ -42,6 +49,7 @@ from functools import cached_property
 from pathlib import Path
 
 import jsonschema
+import referencing
 
 from . import __version__, add_command
 from . import registry as registry_mod
@@ -52,6 +60,8 @@ from .spec import load_yaml
 
 REACHED, UNREACHABLE = "reached", "unreachable"
 KINDS = ("trap", "boundary", "random")
+SCHEMA_VERSION = 2  # of the vector files (header "schema_version"): the one the runners read
+HEADER_SCHEMA = "vector_header.schema.json"  # the header fields every vector file has
 
 
 def _progress(msg):
@@ -203,7 +213,7 @@ class Target:
 
     def header(self, **fields) -> dict:
         """A vector file's header: the fields every header has, then the part's."""
-        return {"kind": "header", "schema_version": 1, "model": self.rel, "model_sha256": self.sha256,
+        return {"kind": "header", "schema_version": SCHEMA_VERSION, "model": self.rel, "model_sha256": self.sha256,
                 "generator": f"railproof_testgen {__version__}", "spin_version": self.spin_version, **fields}
 
     def property_requirements(self, define) -> set:
@@ -267,19 +277,71 @@ def _most_specific(err):
     return err
 
 
-def schema_checked_jsonl(schema_path: Path, lines, name: str) -> str:
-    """Validate every line (header and vectors) against the JSON schema of the vector format
-    and return the JSON Lines text; a line that violates it is a PipelineError naming the
-    file, line and field."""
-    schema = json.loads(Path(schema_path).read_text(encoding="utf-8"))
-    validator = jsonschema.Draft202012Validator(schema)
+def schema_validator(schema_path: Path):
+    """The validator of a capability's vector schema; its header refers to the shared header
+    definition (HEADER_SCHEMA beside it, by its $id), where there is one."""
+    schema_path = Path(schema_path)
+    registry = referencing.Registry()
+    if (shared_path := schema_path.parent / HEADER_SCHEMA).is_file():
+        shared = json.loads(shared_path.read_text(encoding="utf-8"))
+        registry = registry.with_resource(shared["$id"], referencing.Resource.from_contents(shared))
+    return jsonschema.Draft202012Validator(json.loads(schema_path.read_text(encoding="utf-8")), registry=registry)
+
+
+def dump_line(obj) -> str:
+    """One JSON Lines line as the vector files have it (keys sorted, no spaces, newline)."""
+    return json.dumps(obj, sort_keys=True, separators=(",", ":")) + "\n"
+
+
+def seal(header: dict, body: str) -> dict:
+    """The header with the count and the digest of body, the vector lines as written (each
+    with its newline): vector_count, vectors_sha256."""
+    return {**header, "vector_count": body.count("\n"),
+            "vectors_sha256": hashlib.sha256(body.encode("utf-8")).hexdigest()}
+
+
+def sealed_jsonl(schema_path: Path, header: dict, vectors: list, name: str) -> str:
+    """The text of a vector file: the header, sealed (seal), then one vector per line; every
+    line validated against the JSON schema of the vector format first (a violation is a
+    PipelineError naming the file, line and field)."""
+    body = "".join(map(dump_line, vectors))
+    lines = [seal(header, body), *vectors]
+    validator = schema_validator(schema_path)
     for n, obj in enumerate(lines, 1):
-        err = _most_specific(jsonschema.exceptions.best_match(validator.iter_errors(obj)))
+        # the most relevant top-level error (best_match would descend into a oneOf itself and
+        # may blame the vector alternative for a header's fault)
+        err = _most_specific(max(validator.iter_errors(obj), key=jsonschema.exceptions.relevance, default=None))
         if err:
             message = err.message if len(err.message) <= 300 else err.message[:300] + " ..."
             raise PipelineError(f"generated {name} line {n} violates the vector schema: "
                                 f"{'/'.join(map(str, err.absolute_path)) or '(top level)'}: {message}")
-    return "".join(json.dumps(o, sort_keys=True, separators=(",", ":")) + "\n" for o in lines)
+    return dump_line(lines[0]) + body
+
+
+def check_seal(text: str, name: str) -> dict:
+    """The header of a vector file's text if the file is whole: its first line a header of
+    schema version SCHEMA_VERSION whose vector_count and vectors_sha256 match the lines after
+    it; else a PipelineError "<name>:<line>: <reason>"."""
+    head, newline, body = text.partition("\n")
+    try:
+        header = json.loads(head) if newline else None
+    except json.JSONDecodeError as exc:
+        raise PipelineError(f"{name}:1: malformed JSON: {exc.msg}") from None
+    if not isinstance(header, dict) or header.get("kind") != "header":
+        raise PipelineError(f"{name}:1: first line is not a vector header (\"kind\":\"header\")")
+    if header.get("schema_version") != SCHEMA_VERSION:
+        raise PipelineError(f"{name}:1: schema_version {header.get('schema_version')} is not "
+                            f"supported (expected {SCHEMA_VERSION})")
+    if body and not body.endswith("\n"):
+        raise PipelineError(f"{name}:{body.count(chr(10)) + 2}: the last line has no line end (file cut short?)")
+    sealed = seal({}, body)
+    if header.get("vector_count") != sealed["vector_count"]:
+        raise PipelineError(f"{name}:1: the header states {header.get('vector_count')} vectors, "
+                            f"the file has {sealed['vector_count']}")
+    if header.get("vectors_sha256") != sealed["vectors_sha256"]:
+        raise PipelineError(f"{name}:1: the vector lines do not match the header's vectors_sha256 "
+                            "(a vector was changed)")
+    return header
 
 
 # ---- the engine -------------------------------------------------------------------------------
@@ -481,8 +543,8 @@ class Generation:
         texts = {}
         for name, (define, vecs) in files.items():
             if vecs or name == f"{stem}.jsonl":
-                lines = [part.header(self.target, define), *part.order(define, vecs)]
-                texts[name] = schema_checked_jsonl(self.schema, lines, name)
+                texts[name] = sealed_jsonl(self.schema, part.header(self.target, define), part.order(define, vecs),
+                                           name)
         all_vecs = [v for _, vecs in files.values() for v in vecs]
         reached = sum(c["status"] == REACHED for c in coverage)
         cov = {"schema": "railproof/coverage/1", "model": self.target.rel, "goals": coverage, "reached": reached,

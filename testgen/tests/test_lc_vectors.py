@@ -206,8 +206,7 @@ def _vector(config=None, run=ONBOARD_RUN, vid="LC-TRAP-G0"):
 
 def test_schema_accepts_good_and_rejects_bad_records():
     good = [_header(), _vector()]
-    vectors.schema_checked_jsonl(SCHEMA, [_header("GNSS"), _vector("GNSS", GNSS_RUN, "LC-TRAP-GNSS-G60")],
-                                 "lc_gnss.jsonl")
+    vectors.sealed_jsonl(SCHEMA, _header("GNSS"), [_vector("GNSS", GNSS_RUN, "LC-TRAP-GNSS-G60")], "lc_gnss.jsonl")
     check_schema_cases(SCHEMA, good, "lc.jsonl", {
         "units": lambda ls: ls[0].update(units="ticks"),
         "tick length": lambda ls: ls[0]["unit_scales"].update(ms_per_tick=1000),
@@ -228,7 +227,7 @@ def test_schema_accepts_good_and_rejects_bad_records():
     # the message names the field inside the vector (not the whole line) and stays short
     no_list = edited(good, lambda ls: ls[1]["steps"][0]["onboard"]["in"]["reports"][0].pop("requesters"))
     with pytest.raises(PipelineError) as info:
-        vectors.schema_checked_jsonl(SCHEMA, no_list, "lc.jsonl")
+        vectors.sealed_jsonl(SCHEMA, no_list[0], no_list[1:], "lc.jsonl")
     assert "'requesters' is a required property" in str(info.value)
     assert re.search(r"line 2 violates the vector schema: steps/0/\S*reports?\S*: ", str(info.value)), info.value
     assert len(str(info.value)) < 500

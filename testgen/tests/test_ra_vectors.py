@@ -126,8 +126,8 @@ def test_header_records_the_machine_configuration():
 
 
 def test_schema_accepts_good_and_rejects_bad_records():
-    vectors.schema_checked_jsonl(SCHEMA, [_header("ONE_START"), {**_vector(), "id": "RA-TRAP-ONESTART-G0"}],
-                                 "ra.one_start.jsonl")
+    vectors.sealed_jsonl(SCHEMA, _header("ONE_START"), [{**_vector(), "id": "RA-TRAP-ONESTART-G0"}],
+                         "ra.one_start.jsonl")
     check_schema_cases(SCHEMA, [_header(), _vector()], "ra.jsonl", {
         "units": lambda ls: ls[0].update(units="cycles"),
         "configuration and start points disagree": lambda ls: ls[0]["parameters"].update(start_points=1),

@@ -4,6 +4,7 @@ the tiny fixture models of fixtures/spin: tiny.pml (one counter, verification) a
 the variant WIDE, one never, one in configuration FAST). The fixture's part of vector
 generation is the class Counters below, its schema and justification fixtures/spin/spec. The
 vector sets of a build, read from RAILPROOF_RESULTS_DIR, are checked at the end."""
+import hashlib
 import json
 import shutil
 import subprocess
@@ -324,6 +325,12 @@ def test_files_of_every_configuration_with_vectors(generated):
     assert files["counters.wide.jsonl"][0]["configuration"] == "WIDE"
     assert files["counters.wide.jsonl"][0]["parameters"] == {"limit": 4, "steps": 8}
     assert not list(out.glob("*.tmp"))
+    for name, lines in files.items():  # each file whole: its header counts and digests its vector lines
+        text = (out / name).read_text(encoding="utf-8")
+        assert vectors.check_seal(text, name) == lines[0]
+        assert lines[0]["schema_version"] == vectors.SCHEMA_VERSION == 2
+        assert lines[0]["vector_count"] == len(lines) - 1
+        assert lines[0]["vectors_sha256"] == hashlib.sha256(text.split("\n", 1)[1].encode()).hexdigest()
 
 
 @needs_spin
@@ -525,6 +532,103 @@ def test_a_missing_model_bound_is_named(tmp_path):
     with pytest.raises(SpecError, match=r"counters_params.pml: MODEL_STEPS: model bound missing "
                                         r"\(spec/parameters/counters.yaml model_bounds\)"):
         vectors.model_bounds(params, ("limit", "steps"))
+
+
+# ---- the header's seal: a vector file is whole or rejected -------------------------------------
+CT_SCHEMA = FIX / "spec" / "schemas" / "vectors_ct.schema.json"
+
+
+def _ct_file(n=3):
+    """The text of a fixture vector file of n vectors (the header sealed by the engine)."""
+    header = {"kind": "header", "schema_version": vectors.SCHEMA_VERSION, "model": "models/counters.pml",
+              "model_sha256": "0" * 64, "generator": "test", "spin_version": "test", "configuration": "default",
+              "parameters": {"limit": 3, "steps": 6}}
+    vecs = [{"id": f"CT-TRAP-G{k}", "requirements": ["REQ-TG-001"], "goal": f"G{k}", "kind": "trap", "seed": None,
+             "steps": [{"in": {"proc": "up"}, "out": {"a": k + 1, "b": 0}}]} for k in range(n)]
+    return vectors.sealed_jsonl(CT_SCHEMA, header, vecs, "ct.jsonl")
+
+
+def test_the_header_states_the_count_and_the_digest_of_the_lines_as_written():
+    text = _ct_file()
+    head, body = text.split("\n", 1)
+    header = json.loads(head)
+    assert header["vector_count"] == 3 == body.count("\n")
+    assert header["vectors_sha256"] == hashlib.sha256(body.encode("utf-8")).hexdigest()
+    assert vectors.check_seal(text, "ct.jsonl") == header
+    # no vectors: the count is 0 and the digest that of nothing
+    empty = vectors.seal({"kind": "header"}, "")
+    assert empty["vector_count"] == 0 and empty["vectors_sha256"] == hashlib.sha256(b"").hexdigest()
+
+
+def _damaged(text, how):
+    lines = text.splitlines(keepends=True)
+    return {
+        "cut at a line boundary": lambda: "".join(lines[:-1]),
+        "a line dropped": lambda: "".join(lines[:2] + lines[3:]),
+        "a line duplicated": lambda: "".join(lines[:3] + lines[2:]),
+        "two lines swapped": lambda: "".join([lines[0], lines[2], lines[1], *lines[3:]]),
+        "a value edited": lambda: text.replace('"a":2', '"a":5'),
+        "a line added": lambda: text + lines[-1],
+        "a blank line added": lambda: text + "\n",
+        "cut inside a line": lambda: text[:-10],
+        "the last newline lost": lambda: text[:-1],
+        "line ends changed": lambda: text.replace("\n", "\r\n"),
+        "an older schema version": lambda: text.replace('"schema_version":2', '"schema_version":1', 1),
+        "no header": lambda: "".join(lines[1:]),
+        "malformed header": lambda: "{" + text,
+    }[how]()
+
+
+@pytest.mark.parametrize("how, message", [
+    ("cut at a line boundary", "ct.jsonl:1: the header states 3 vectors, the file has 2"),
+    ("a line dropped", "ct.jsonl:1: the header states 3 vectors, the file has 2"),
+    ("a line duplicated", "ct.jsonl:1: the header states 3 vectors, the file has 4"),
+    ("a line added", "ct.jsonl:1: the header states 3 vectors, the file has 4"),
+    ("a blank line added", "ct.jsonl:1: the header states 3 vectors, the file has 4"),
+    ("two lines swapped", "ct.jsonl:1: the vector lines do not match the header's vectors_sha256 (a vector was changed)"),
+    ("a value edited", "ct.jsonl:1: the vector lines do not match the header's vectors_sha256 (a vector was changed)"),
+    ("line ends changed", "ct.jsonl:1: the vector lines do not match the header's vectors_sha256 (a vector was changed)"),
+    ("cut inside a line", "ct.jsonl:4: the last line has no line end (file cut short?)"),
+    ("the last newline lost", "ct.jsonl:4: the last line has no line end (file cut short?)"),
+    ("an older schema version", "ct.jsonl:1: schema_version 1 is not supported (expected 2)"),
+    ("no header", 'ct.jsonl:1: first line is not a vector header ("kind":"header")'),
+    ("malformed header", "ct.jsonl:1: malformed JSON: "),
+])
+def test_a_damaged_file_is_rejected_by_its_seal(how, message):
+    with pytest.raises(PipelineError) as info:
+        vectors.check_seal(_damaged(_ct_file(), how), "ct.jsonl")
+    assert str(info.value).startswith(message) and "\n" not in str(info.value)
+
+
+def test_the_vector_schemas_require_the_seal():
+    """Every capability's header takes the shared definition (spec/schemas/vector_header.schema.json):
+    the count and the digest are required and well formed, the version is the current one and
+    a key of no definition is refused."""
+    from railproof_testgen.capabilities.br import PART as BR
+    model = REPO / "models" / "br.pml"
+    header = vectors.seal(BR.header(vectors.Target(model, spin.parse_annotations(model), {"vmax": 9, "cycles": 6},
+                                                   "test"), None), "")
+    shared = json.loads((REPO / "spec" / "schemas" / vectors.HEADER_SCHEMA).read_text(encoding="utf-8"))
+    assert shared["$defs"]["header"]["properties"]["schema_version"] == {"const": vectors.SCHEMA_VERSION}
+    for name in {c.name for c in registry.load(REPO / "spec").capabilities if c.models}:
+        schema = json.loads((REPO / "spec" / "schemas" / f"vectors_{name}.schema.json").read_text(encoding="utf-8"))
+        assert schema["$defs"]["header"]["$ref"] == f"{shared['$id']}#/$defs/header", name
+        assert schema["$defs"]["header"]["unevaluatedProperties"] is False, name
+    validator = vectors.schema_validator(REPO / "spec" / "schemas" / "vectors_br.schema.json")
+    assert not list(validator.iter_errors(header))
+    for what, edit in {
+        "no count": lambda h: h.pop("vector_count"),
+        "no digest": lambda h: h.pop("vectors_sha256"),
+        "a negative count": lambda h: h.update(vector_count=-1),
+        "a count as text": lambda h: h.update(vector_count="3"),
+        "a digest in capitals": lambda h: h.update(vectors_sha256=h["vectors_sha256"].upper()),
+        "a short digest": lambda h: h.update(vectors_sha256="e3b0c442"),
+        "the former version": lambda h: h.update(schema_version=1),
+        "an unknown key": lambda h: h.update(vector_total=0),
+    }.items():
+        broken = json.loads(json.dumps(header))
+        edit(broken)
+        assert list(validator.iter_errors(broken)), f"schema accepted: {what}"
 
 
 # ---- the registry's capabilities ---------------------------------------------------------------

@@ -9,7 +9,6 @@ import json
 import os
 from pathlib import Path
 
-import jsonschema
 import pytest
 import yaml
 
@@ -28,8 +27,8 @@ class VectorSet:
         self.path = REPO / "models" / f"{model}.pml"
         self.capability = registry.load(REPO / "spec").of_model(self.path).name
         names = [f"{model}.jsonl"] + sorted(p.name for p in vector_dir.glob(f"{model}.*.jsonl"))
-        self.files = {n: [json.loads(ln) for ln in (vector_dir / n).read_text(encoding="utf-8").splitlines()]
-                      for n in names}
+        self.texts = {n: (vector_dir / n).read_text(encoding="utf-8") for n in names}
+        self.files = {n: [json.loads(ln) for ln in text.splitlines()] for n, text in self.texts.items()}
         self.coverage = json.loads((vector_dir / f"{model}.coverage.json").read_text(encoding="utf-8"))
 
     def header(self, name: str) -> dict:
@@ -53,8 +52,7 @@ class VectorSet:
         return {e["goal"]: e["id"] for e in entries if e["model"] == f"models/{self.model}.pml"}
 
     def schema_validator(self):
-        schema = REPO / "spec" / "schemas" / f"vectors_{self.capability}.schema.json"
-        return jsonschema.Draft202012Validator(json.loads(schema.read_text(encoding="utf-8")))
+        return vectors.schema_validator(REPO / "spec" / "schemas" / f"vectors_{self.capability}.schema.json")
 
 
 def vector_set(model: str) -> VectorSet:
@@ -72,13 +70,14 @@ def vector_set(model: str) -> VectorSet:
 
 
 def check_vector_set(vs: VectorSet):
-    """What every vector set must satisfy: every line schema-valid, headers naming the model as
-    it is now, unique ids, every goal reached with vectors in the files or unreachable with the
+    """What every vector set must satisfy: every file whole (its header's count and digest
+    match its vector lines), every line schema-valid, headers naming the model as it is now, unique ids, every goal reached with vectors in the files or unreachable with the
     justification spec/justifications gives it, and a coverage record that counts the files."""
     validator = vs.schema_validator()
     ids = set()
     for name, lines in vs.files.items():
         assert len(lines) > 1, f"{name}: no vectors"
+        assert vectors.check_seal(vs.texts[name], name) == lines[0]
         for n, obj in enumerate(lines, 1):
             errors = list(validator.iter_errors(obj))
             assert not errors, f"{name} line {n}: {errors[0].message}"
@@ -120,10 +119,12 @@ def edited(records: list, edit) -> list:
 
 def check_schema_cases(schema: Path, good: list, name: str, broken: dict):
     """The records good (a header and vectors) pass the vector schema unchanged as the file
-    name; each edit of broken ({what: edit of a copy of good}) makes them fail it."""
-    text = vectors.schema_checked_jsonl(schema, good, name)
-    assert [json.loads(ln) for ln in text.splitlines()] == good
+    name (the header sealed with their count and digest); each edit of broken ({what: edit of a
+    copy of good}) makes them fail it."""
+    text = vectors.sealed_jsonl(schema, good[0], good[1:], name)
+    assert [json.loads(ln) for ln in text.splitlines()] == [vectors.seal(good[0], text.partition("\n")[2]), *good[1:]]
     for what, edit in broken.items():
         with pytest.raises(PipelineError, match="violates the vector schema"):
-            vectors.schema_checked_jsonl(schema, edited(good, edit), name)
+            lines = edited(good, edit)
+            vectors.sealed_jsonl(schema, lines[0], lines[1:], name)
             pytest.fail(f"schema accepted: {what}")

@@ -23,6 +23,7 @@
 
 #include "railproof/br/supervisor.hpp"
 #include "railproof/testing/jsonl_runner.hpp"
+#include "vector_keys.hpp"
 
 namespace rcli = railproof::conformance;
 
@@ -91,6 +92,7 @@ int main(int argc, char** argv) {
                                .prefix = "br",
                                .models = {"models/br.pml"},
                                .units = "abstract speed units = mm/s",
+                               .keys = rcli::BrVectorKeys(),
                                .header = nullptr,  // nothing else in the header
                                .step_ok = StepWellFormed,
                                .replay = Replay},

@@ -45,6 +45,7 @@
 #include "railproof/lc/wayside/centre_scheduler.hpp"
 #include "railproof/lc/wayside/crossing_controller.hpp"
 #include "railproof/testing/jsonl_runner.hpp"
+#include "vector_keys.hpp"
 
 namespace rcli = railproof::conformance;
 
@@ -85,7 +86,7 @@ std::string ConfigFromHeader(const json& h, FileConfig& cfg) {
       !IsObj(p, "protection") || !IsObj(p, "controller")) {
     return "header parameters need train, crossings, restrictions, protection, controller";
   }
-  const std::string variant = h.value("variant", "");
+  const std::string variant = rcli::StringField(h, "variant");
   if (variant != "ONBOARD" && variant != "GNSS") {
     return "header variant must be ONBOARD or GNSS";
   }
@@ -626,6 +627,7 @@ int main(int argc, char** argv) {
        // the two level-crossing models: the on-board-requested warning and the GNSS-time crossings
        .models = {"models/lc.pml", "models/lc_gnss.pml"},
        .units = kUnits,
+       .keys = rcli::LcVectorKeys(),
        .header = Header,
        .step_ok = StepWellFormed,
        .replay = Replay},

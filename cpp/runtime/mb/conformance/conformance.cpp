@@ -33,6 +33,7 @@
 #include "railproof/mb/onboard/authority.hpp"
 #include "railproof/mb/wayside/ground.hpp"
 #include "railproof/testing/jsonl_runner.hpp"
+#include "vector_keys.hpp"
 #include "../tests/line_data.hpp"
 
 namespace rcli = railproof::conformance;
@@ -57,11 +58,13 @@ std::map<std::string, Header> g_headers;  // per file
 
 // A file's header: the time scale and the parameters of its vectors.
 std::string ReadHeader(const std::string& file, const json& obj) {
-  if (!obj.contains("unit_scales")) {
-    return "first line is not a models/mb.pml vector header";
+  const auto scales = obj.find("unit_scales");
+  if (scales == obj.end() || !scales->is_object() || !scales->contains("time_ms_per_tick") ||
+      !(*scales)["time_ms_per_tick"].is_number_integer()) {
+    return "header unit_scales.time_ms_per_tick must be an integer";
   }
   Header h;
-  h.tick_ms = obj["unit_scales"].value("time_ms_per_tick", std::int64_t{0});
+  h.tick_ms = (*scales)["time_ms_per_tick"].get<std::int64_t>();
   h.p = obj["parameters"];
   if (h.tick_ms <= 0) {
     return "unit_scales.time_ms_per_tick must be positive";
@@ -265,6 +268,7 @@ int main(int argc, char** argv) {
        .prefix = "mb",
        .models = {"models/mb.pml"},
        .units = "",  // the header states none
+       .keys = rcli::MbVectorKeys(),
        .header = ReadHeader,
        .step_ok = nullptr,  // the replay reads each step with at()
        .replay = Replay},

@@ -28,6 +28,7 @@
 
 #include "railproof/ra/readhesion_machine.hpp"
 #include "railproof/testing/jsonl_runner.hpp"
+#include "vector_keys.hpp"
 
 namespace rcli = railproof::conformance;
 
@@ -187,6 +188,7 @@ int main(int argc, char** argv) {
                                .prefix = "ra",
                                .models = {"models/ra.pml"},
                                .units = "model ticks = cycles, model margin units = mm",
+                               .keys = rcli::RaVectorKeys(),
                                .header = Header,
                                .step_ok = StepWellFormed,
                                .replay = Replay},

@@ -3,20 +3,34 @@
 
 #include <algorithm>
 #include <cctype>
-#include <fstream>
 #include <limits>
 #include <set>
-#include <sstream>
 #include <stdexcept>
-#include <system_error>
 
 #include <nlohmann/json.hpp>
+
+#include "railproof/testing/vector_file.hpp"
 
 namespace railproof::conformance {
 namespace {
 
 using nlohmann::json;
 namespace rr = railproof::tg;
+
+// The keys of the tg vector files besides those every vector file has (vector_file.hpp), as
+// spec/schemas/vectors_tg.schema.json defines them (the keys of both kinds of step
+// together; ParseStep refuses those of the other kind): any other key is refused.
+VectorKeys TgVectorKeys() {
+  return VectorKeys{
+      .header = KeyTree::parse(R"({"unit_scales": null, "parameters": null, "variant": null})"),
+      .vector = KeyTree::parse(R"({"role": null})"),
+      .step = KeyTree::parse(R"({
+          "in": {"ev": null, "tg": {"src": null, "dst": null, "type": null, "seq": null, "echo": null,
+          "auth": null, "integrity": null}},
+          "out": {"tx": {"seq": null, "echo": null}, "link": null, "eb": null, "tracking": null,
+          "verdict": null, "gap": null}
+      })")};
+}
 
 // Thrown inside this file only; LoadVectorDirectory turns it into an error line.
 struct FormatError : std::runtime_error {
@@ -92,14 +106,14 @@ T OneOf(const json& object, const char* key, const std::string& where,
       return result;
     }
   }
-  throw FormatError("field \"" + Name(where, key) + "\" has unknown value \"" + value + "\"");
+  throw FormatError("field \"" + Name(where, key) + "\" has unknown value " + Quoted(value));
 }
 
 void OnlyKeys(const json& object, const std::string& where, std::initializer_list<const char*> allowed) {
   for (auto it = object.begin(); it != object.end(); ++it) {
     const std::string& key = it.key();
     if (std::none_of(allowed.begin(), allowed.end(), [&key](const char* a) { return key == a; })) {
-      throw FormatError("unknown field \"" + Name(where, key.c_str()) + "\"");
+      throw FormatError("unknown field " + Quoted(Name(where, key.c_str())));
     }
   }
 }
@@ -126,7 +140,6 @@ void ParseRoleOutputs(const json& out, const std::string& where, rr::Role role, 
 
 Step ParseStep(const json& step, std::size_t index, rr::Role role) {
   const std::string where = "steps[" + std::to_string(index) + "]";
-  OnlyKeys(step, where, {"in", "out"});
   const json& in = Field(step, "in", where);
   const json& out = Field(step, "out", where);
   const std::string win = where + ".in";
@@ -138,7 +151,6 @@ Step ParseStep(const json& step, std::size_t index, rr::Role role) {
     OnlyKeys(out, wout, {"tx", "link", "eb", "tracking"});
     s.kind = Step::Kind::kTick;
     const json& tx = Field(out, "tx", wout);
-    OnlyKeys(tx, wout + ".tx", {"seq", "echo"});
     s.out.tx_seq = U32(tx, "seq", wout + ".tx");
     s.out.tx_echo = OptionalU32(tx, "echo", wout + ".tx");
   } else if (ev == "rx") {
@@ -147,7 +159,6 @@ Step ParseStep(const json& step, std::size_t index, rr::Role role) {
     s.kind = Step::Kind::kRx;
     const json& tg = Field(in, "tg", win);
     const std::string wtg = win + ".tg";
-    OnlyKeys(tg, wtg, {"src", "dst", "type", "seq", "echo", "auth", "integrity"});
     s.tg.src = U16(tg, "src", wtg);
     s.tg.dst = U16(tg, "dst", wtg);
     s.tg.type = OneOf<rr::TelegramType>(tg, "type", wtg,
@@ -160,25 +171,20 @@ Step ParseStep(const json& step, std::size_t index, rr::Role role) {
     const std::string verdict = String(out, "verdict", wout);
     const auto parsed = ParseVerdict(verdict);
     if (!parsed) {
-      throw FormatError("field \"" + wout + ".verdict\" has unknown value \"" + verdict + "\"");
+      throw FormatError("field \"" + wout + ".verdict\" has unknown value " + Quoted(verdict));
     }
     s.out.verdict = *parsed;
     s.out.gap = U32(out, "gap", wout);
   } else {
-    throw FormatError("field \"" + win + ".ev\" has unknown value \"" + ev + "\"");
+    throw FormatError("field \"" + win + ".ev\" has unknown value " + Quoted(ev));
   }
   s.out.link = ParseLink(out, wout);
   ParseRoleOutputs(out, wout, role, s.out);
   return s;
 }
 
+// (kind, schema version, count and digest: ReadVectorFile)
 FileHeader ParseHeader(const json& h, const std::string& file) {
-  if (String(h, "kind", "") != "header") {
-    throw FormatError("first line is not a header (\"kind\":\"header\")");
-  }
-  if (Unsigned(h, "schema_version", "", 1000) != 1) {
-    throw FormatError("unsupported schema_version (expected 1)");
-  }
   FileHeader fh;
   fh.file = file;
   fh.model = String(h, "model", "");
@@ -293,44 +299,32 @@ std::string SanitizeTestName(const std::string& id) {
 }
 
 bool ParseVectorFile(const std::string& file_name, const std::string& text, VectorSet& set, std::string& error) {
-  std::istringstream lines(text);
-  std::string line;
-  std::size_t line_no = 0;
-  std::optional<std::size_t> header_index;
+  VectorFile file;
+  if (std::string e = ReadVectorFile(file_name, text, TgVectorKeys(), file); !e.empty()) {
+    error = e;
+    return false;
+  }
   std::set<std::string> names;
   for (const Vector& v : set.vectors) {
     names.insert(v.test_name);
   }
-  while (std::getline(lines, line)) {
-    ++line_no;
-    if (!line.empty() && line.back() == '\r') {
-      line.pop_back();
-    }
-    if (std::all_of(line.begin(), line.end(), [](unsigned char c) { return std::isspace(c) != 0; })) {
-      continue;
-    }
-    try {
-      const json j = json::parse(line);
-      if (!header_index) {
-        set.headers.push_back(ParseHeader(j, file_name));
-        header_index = set.headers.size() - 1;
-        continue;
-      }
-      Vector v = ParseVector(j, file_name, line_no, *header_index);
+  std::size_t line_no = 1;
+  try {
+    set.headers.push_back(ParseHeader(file.header, file_name));
+    const std::size_t header_index = set.headers.size() - 1;
+    for (const VectorLine& line : file.vectors) {
+      line_no = line.line;
+      Vector v = ParseVector(line.obj, file_name, line_no, header_index);
       if (!names.insert(v.test_name).second) {
         throw FormatError("duplicate vector id / test name \"" + v.test_name + "\"");
       }
       set.vectors.push_back(std::move(v));
-    } catch (const json::exception& e) {
-      error = file_name + ":" + std::to_string(line_no) + ": malformed JSON: " + e.what();
-      return false;
-    } catch (const FormatError& e) {
-      error = file_name + ":" + std::to_string(line_no) + ": " + e.what();
-      return false;
     }
-  }
-  if (!header_index) {
-    error = file_name + ": no header line (empty file)";
+  } catch (const json::exception& e) {
+    error = file_name + ":" + std::to_string(line_no) + ": malformed: " + e.what();
+    return false;
+  } catch (const FormatError& e) {
+    error = file_name + ":" + std::to_string(line_no) + ": " + e.what();
     return false;
   }
   return true;
@@ -338,43 +332,25 @@ bool ParseVectorFile(const std::string& file_name, const std::string& text, Vect
 
 LoadResult LoadVectorDirectory(const std::filesystem::path& dir) {
   LoadResult result;
-  std::error_code ec;
-  if (!std::filesystem::is_directory(dir, ec)) {
-    result.error = "vector directory " + dir.string() + " does not exist or is not a directory";
-    return result;
-  }
+  // tg*.jsonl: the telegram-layer vectors (other models' files are replayed by their own
+  // runners, e.g. railproof_conformance_mb for mb*.jsonl)
   std::vector<std::filesystem::path> files;
-  for (const auto& entry : std::filesystem::directory_iterator(dir, ec)) {
-    // tg*.jsonl: the telegram-layer vectors (other models' files are replayed by
-    // their own runners, e.g. railproof_conformance_mb for mb*.jsonl)
-    if (entry.is_regular_file() && entry.path().extension() == ".jsonl" &&
-        entry.path().filename().string().rfind("tg", 0) == 0) {
-      files.push_back(entry.path());
-    }
-  }
-  if (ec) {
-    result.error = "cannot list vector directory " + dir.string() + ": " + ec.message();
-    return result;
-  }
-  std::sort(files.begin(), files.end());
-  if (files.empty()) {
-    result.error = "no *.jsonl vector file in " + dir.string() + " (tg*.jsonl)";
+  if (std::string e = ListVectorFiles(dir, "tg", files); !e.empty()) {
+    result.error = e;
     return result;
   }
   for (const auto& path : files) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) {
-      result.error = path.string() + ": cannot be read";
+    std::string text;
+    if (std::string e = ReadFileText(path, text); !e.empty()) {
+      result.error = e;
       return result;
     }
-    std::ostringstream text;
-    text << in.rdbuf();
-    if (!ParseVectorFile(path.string(), text.str(), result.set, result.error)) {
+    if (!ParseVectorFile(path.string(), text, result.set, result.error)) {
       return result;
     }
   }
   if (result.set.vectors.empty()) {
-    result.error = "no vector in the " + std::to_string(files.size()) + " *.jsonl file(s) of " + dir.string();
+    result.error = "no vector in the " + std::to_string(files.size()) + " tg*.jsonl file(s) of " + dir.string();
     return result;
   }
   result.ok = true;

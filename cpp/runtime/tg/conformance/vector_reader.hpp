@@ -1,6 +1,9 @@
 // Reader of the conformance vectors (JSON Lines, spec/design/tg.md §7): one
-// header line per file, then one vector per line. Test-only code (may allocate); it never
-// throws: every problem is reported as a LoadResult error naming the file and line.
+// header line per file, then one vector per line. Each file is read whole or not at all by
+// ReadVectorFile (railproof/testing/vector_file.hpp: schema version, count, digest,
+// duplicate and unknown keys), then the telegram fields are checked here. Test-only code
+// (may allocate); it never throws: every problem is reported as a LoadResult error naming
+// the file and line.
 #pragma once
 
 #include <cstddef>
@@ -110,7 +113,9 @@ std::string SanitizeTestName(const std::string& id);
 // line (naming file and line) and on duplicate test names.
 LoadResult LoadVectorDirectory(const std::filesystem::path& dir);
 
-// Parses one file's text (exposed for tests of the reader itself).
+// Parses one file's text, appending its header and vectors to set; false and a one-line
+// error "<file>:<line>: <reason>" if the file is not whole or not well formed (exposed for
+// the reader's fuzz target, cpp/testing/fuzz).
 bool ParseVectorFile(const std::string& file_name, const std::string& text, VectorSet& set, std::string& error);
 
 }  // namespace railproof::conformance

@@ -31,21 +31,28 @@ struct JsonVector {
   nlohmann::json steps;
 };
 
-// "" if obj is the header line of a vector file of one of `models` (kind "header", the
-// model, parameters) stating `units` (if not empty); else the reason.
+// The string obj[key], or "" if obj has none there.
+inline std::string StringField(const nlohmann::json& obj, const char* key) {
+  const auto it = obj.find(key);
+  return it != obj.end() && it->is_string() ? it->get<std::string>() : std::string();
+}
+
+// "" if obj is the header line of a vector file of one of `models` (the model, parameters)
+// stating `units` (if not empty); else the reason. (Kind, version, count and digest:
+// ReadVectorFile.)
 inline std::string CheckHeader(const nlohmann::json& obj, const std::vector<std::string>& models,
                                const std::string& units) {
-  const std::string model = obj.value("model", "");
+  const std::string model = StringField(obj, "model");
   bool known = false;
   std::string names;
   for (const std::string& m : models) {
     known = known || model == m;
     names += (names.empty() ? "" : " or ") + m;
   }
-  if (obj.value("kind", "") != "header" || !known || !obj.contains("parameters")) {
+  if (!known || !obj.contains("parameters") || !obj["parameters"].is_object()) {
     return "first line is not a " + names + " vector header";
   }
-  if (!units.empty() && obj.value("units", "") != units) {
+  if (!units.empty() && StringField(obj, "units") != units) {
     return "header units must be \"" + units + "\"";
   }
   return "";
@@ -58,6 +65,9 @@ struct JsonRunner {
   std::string prefix;       // the vector files are <prefix>*.jsonl
   std::vector<std::string> models;  // a file's header names one of these models
   std::string units;                // ... and states these units ("": it states none)
+  // the keys of its header, vectors and steps besides those every vector file has: any
+  // other key is refused (vector_file.hpp)
+  VectorKeys keys;
   // checks the rest of a file's header (its first line) and keeps what the file's vectors
   // need: "" or the reason the file is unusable; empty: nothing more to check
   std::function<std::string(const std::string& file, const nlohmann::json& header)> header;
@@ -78,7 +88,7 @@ inline int RunJsonVectors(const JsonRunner& r, int argc, char** argv) {
       [&](const std::string& dir) {
         std::size_t read = 0;
         const std::string error = ReadVectorDirectory(
-            dir, r.prefix,
+            dir, r.prefix, r.keys,
             [&](const std::string& file, const nlohmann::json& obj) -> std::string {
               std::string e = CheckHeader(obj, r.models, r.units);
               if (e.empty() && r.header) {
@@ -89,12 +99,12 @@ inline int RunJsonVectors(const JsonRunner& r, int argc, char** argv) {
               }
               return e;
             },
-            [&](const VectorLine& line) -> std::string {
+            [&](const VectorLineRef& line) -> std::string {
               const nlohmann::json& steps = (*line.obj)["steps"];
               if (r.step_ok) {
-                for (const nlohmann::json& step : steps) {
-                  if (!r.step_ok(line.file, step)) {
-                    return "malformed step in vector " + line.id;
+                for (std::size_t k = 0; k < steps.size(); ++k) {
+                  if (!r.step_ok(line.file, steps[k])) {
+                    return "malformed step " + std::to_string(k) + " in vector " + Quoted(line.id);
                   }
                 }
               }

@@ -1,19 +1,20 @@
 // Reading a directory of JSON Lines vector files (<prefix>*.jsonl: a header line, then one
-// vector per line), shared by the conformance runners of br, ra, lc and mb (jsonl_runner.hpp). Every
-// error names the file and line; the capability-specific checks (header fields, step
-// shape) are the callbacks'.
+// vector per line), shared by the conformance runners of br, ra, lc and mb (jsonl_runner.hpp).
+// Each file is read whole or not at all by ReadVectorFile (vector_file.hpp: schema version,
+// count, digest, duplicate and unknown keys); the capability-specific checks (header fields,
+// step shape) are the callbacks'. Every error names the file and line.
 #pragma once
 
 #include <nlohmann/json.hpp>
 
-#include <algorithm>
 #include <cstddef>
 #include <filesystem>
-#include <fstream>
 #include <functional>
 #include <set>
 #include <string>
 #include <vector>
+
+#include "railproof/testing/vector_file.hpp"
 
 namespace railproof::conformance {
 
@@ -28,7 +29,7 @@ inline std::string Sanitize(const std::string& s) {
   return out;
 }
 
-struct VectorLine {
+struct VectorLineRef {
   std::string file;       // file name (no directory)
   std::string where;      // "file:line" for messages
   std::string test_name;  // Sanitize(stem + "_" + id), unique over the directory
@@ -37,83 +38,61 @@ struct VectorLine {
   const nlohmann::json* obj = nullptr;  // the whole vector (id, steps non-empty list, ...)
 };
 
-// Reads every <prefix>*.jsonl of dir in name order. on_header(file, where, obj) is called
-// for the first line of each file, on_vector for every other non-empty line whose object
-// has a string id and a non-empty steps list; a callback returns "" or an error reason
-// (reported with its file and line). Returns "" or the first error; `files` receives the
-// number of files read.
+// Reads every <prefix>*.jsonl of dir in name order, each with ReadVectorFile and the runner's
+// keys. on_header(file, obj) is called for the header of each file, on_vector for every
+// vector whose object has a string id and a non-empty steps list; a callback returns "" or
+// an error reason (reported with its file and line; a JSON type error it throws too).
+// Returns "" or the first error; `files` receives the number of files read.
 inline std::string ReadVectorDirectory(
-    const std::filesystem::path& dir, const std::string& prefix,
+    const std::filesystem::path& dir, const std::string& prefix, const VectorKeys& keys,
     const std::function<std::string(const std::string&, const nlohmann::json&)>& on_header,
-    const std::function<std::string(const VectorLine&)>& on_vector, std::size_t& files) {
-  namespace fs = std::filesystem;
+    const std::function<std::string(const VectorLineRef&)>& on_vector, std::size_t& files) {
   files = 0;
-  std::error_code ec;
-  if (!fs::is_directory(dir, ec)) {
-    return "vector directory " + dir.string() + " does not exist";
-  }
-  std::vector<fs::path> paths;
-  for (const auto& e : fs::directory_iterator(dir, ec)) {
-    const std::string name = e.path().filename().string();
-    if (e.is_regular_file() && e.path().extension() == ".jsonl" && name.rfind(prefix, 0) == 0) {
-      paths.push_back(e.path());
-    }
-  }
-  std::sort(paths.begin(), paths.end());
-  if (paths.empty()) {
-    return "no *.jsonl vector file (" + prefix + "*.jsonl) in " + dir.string();
+  std::vector<std::filesystem::path> paths;
+  if (std::string e = ListVectorFiles(dir, prefix, paths); !e.empty()) {
+    return e;
   }
   std::set<std::string> names;
   std::size_t vectors = 0;
-  for (const fs::path& f : paths) {
-    std::ifstream in(f);
+  for (const std::filesystem::path& f : paths) {
+    const std::string name = f.filename().string();
     std::string text;
-    std::size_t n = 0;
-    bool have_header = false;
-    while (std::getline(in, text)) {
-      ++n;
-      const std::string where = f.filename().string() + ":" + std::to_string(n);
-      if (text.empty()) {
-        continue;
-      }
-      const nlohmann::json obj = nlohmann::json::parse(text, nullptr, false);
-      if (obj.is_discarded() || !obj.is_object()) {
-        return where + ": not a JSON object";
-      }
-      if (!have_header) {
-        if (std::string e = on_header(f.filename().string(), obj); !e.empty()) {
-          return where + ": " + e;
-        }
-        have_header = true;
-        continue;
-      }
-      if (!obj.contains("id") || !obj["id"].is_string() || !obj.contains("steps") ||
-          !obj["steps"].is_array() || obj["steps"].empty()) {
-        return where + ": vector needs an id and a non-empty steps list";
-      }
-      VectorLine v;
-      v.file = f.filename().string();
-      v.where = where;
-      v.id = obj["id"].get<std::string>();
-      v.test_name = Sanitize(f.stem().string() + "_" + v.id);
-      v.line = n;
-      v.obj = &obj;
-      if (!names.insert(v.test_name).second) {
-        return where + ": duplicate vector id " + v.id;
-      }
-      if (std::string e = on_vector(v); !e.empty()) {
+    if (std::string e = ReadFileText(f, text); !e.empty()) {
+      return e;
+    }
+    VectorFile file;
+    if (std::string e = ReadVectorFile(name, text, keys, file); !e.empty()) {
+      return e;
+    }
+    std::string where = name + ":1";
+    try {
+      if (std::string e = on_header(name, file.header); !e.empty()) {
         return where + ": " + e;
       }
-      ++vectors;
-    }
-    if (!have_header) {
-      return f.filename().string() + ": empty file (no header)";
+      for (const VectorLine& line : file.vectors) {
+        where = name + ":" + std::to_string(line.line);
+        const nlohmann::json& obj = line.obj;
+        if (!obj.contains("id") || !obj["id"].is_string() || !obj.contains("steps") || !obj["steps"].is_array() ||
+            obj["steps"].empty()) {
+          return where + ": vector needs an id and a non-empty steps list";
+        }
+        VectorLineRef v{name, where, Sanitize(f.stem().string() + "_" + obj["id"].get<std::string>()),
+                        obj["id"].get<std::string>(), line.line, &obj};
+        if (!names.insert(v.test_name).second) {
+          return where + ": duplicate vector id " + Quoted(v.id);
+        }
+        if (std::string e = on_vector(v); !e.empty()) {
+          return where + ": " + e;
+        }
+        ++vectors;
+      }
+    } catch (const nlohmann::json::exception& e) {
+      return where + ": malformed: " + e.what();
     }
     ++files;
   }
   if (vectors == 0) {
-    return "no vector in the " + std::to_string(paths.size()) + " " + prefix + "*.jsonl file(s) of " +
-           dir.string();
+    return "no vector in the " + std::to_string(paths.size()) + " " + prefix + "*.jsonl file(s) of " + dir.string();
   }
   return "";
 }

@@ -3,8 +3,10 @@
 //   <runner> --vectors DIR [--junit FILE] [--gtest_* flags]
 // The command line is parsed by CLI11, as every tool's (railproof/offline/cli.hpp): --help
 // prints the generated help and exits 0; bad usage prints "<prog>: error: <reason> (see
-// --help)" and exits 2. Exit status 0 if every vector passed, 1 if not (or no usable vector
-// set). The last line printed is one of
+// --help)" and exits 2, and so does a report path (--junit, --gtest_output) that cannot be
+// written ("<prog>: error: cannot write the test report <path>: <reason>", checked before
+// anything runs). Exit status 0 if every vector passed, 1 if not (or no usable vector set).
+// The last line printed is one of
 //   "<prog>: all N vectors passed (M in the set)"
 //   "<prog>: vectors mismatched: K of N"      (the seeded-fault tests look for K > 0)
 //   "<prog>: error: <reason>"
@@ -13,9 +15,16 @@
 #include <CLI/CLI.hpp>
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <atomic>
+#include <cerrno>
 #include <cstddef>
 #include <cstdio>
+#include <cstring>
+#include <exception>
+#include <filesystem>
+#include <fstream>
 #include <functional>
 #include <optional>
 #include <string>
@@ -49,6 +58,47 @@ class VectorSetTest : public testing::Test {
   std::size_t vectors_;
 };
 
+// "" if GoogleTest can write the report its --gtest_output flag names (`xml`, `xml:FILE`,
+// `xml:DIR/`; GoogleTest aborts the run when it cannot), else the reason. Creates the
+// report's directory as GoogleTest would; leaves no file behind.
+inline std::string ReportPathProblem(const std::string& flag) {
+  namespace fs = std::filesystem;
+  if (flag.empty()) {
+    return "";
+  }
+  const std::size_t colon = flag.find(':');
+  const std::string format = flag.substr(0, colon);
+  const fs::path path = colon == std::string::npos || colon + 1 == flag.size() ? "test_detail." + format
+                                                                                : flag.substr(colon + 1);
+  const std::string cannot = "cannot write the test report " + path.string() + ": ";
+  const bool dir_form = path.string().back() == '/';
+  const fs::path dir = dir_form ? path : path.parent_path();
+  std::error_code ec;
+  if (!dir.empty()) {
+    fs::create_directories(dir, ec);
+    if (ec) {
+      return cannot + ec.message();
+    }
+  }
+  if (dir_form) {
+    return ::access(dir.c_str(), W_OK) == 0 ? "" : cannot + std::strerror(errno);
+  }
+  if (fs::is_directory(path, ec)) {
+    return cannot + "it is a directory";
+  }
+  const bool existed = fs::exists(path, ec);
+  {
+    std::ofstream probe(path, std::ios::app);  // does not change an existing file
+    if (!probe) {
+      return cannot + std::strerror(errno);
+    }
+  }
+  if (!existed) {
+    fs::remove(path, ec);
+  }
+  return "";
+}
+
 // Reads the runner's own flags (CLI11), passes --gtest_* flags (and --junit as --gtest_output)
 // to GoogleTest and initialises it. `description` opens the help.
 inline RunnerArgs ParseArgsAndInitGoogleTest(const char* prog, const std::string& description, int argc, char** argv) {
@@ -59,7 +109,8 @@ inline RunnerArgs ParseArgsAndInitGoogleTest(const char* prog, const std::string
   app.add_option("--vectors", out.vectors_dir, "directory of the conformance vectors (*.jsonl)")->required();
   app.add_option("--junit", junit, "write JUnit XML (as --gtest_output=xml:FILE)");
   app.footer("Other --gtest_* flags are passed to GoogleTest. Exit status: 0 every vector passed; 1 a\n"
-             "vector failed or the vector set is missing, empty or malformed; 2 bad usage.");
+             "vector failed or the vector set is missing, empty or malformed; 2 bad usage or a test\n"
+             "report that cannot be written.");
   const auto usage_error = [&](const std::string& reason) {
     std::fprintf(stderr, "%s: error: %s (see --help)\n", prog, reason.c_str());
     out.exit_code = 2;
@@ -103,6 +154,10 @@ inline RunnerArgs ParseArgsAndInitGoogleTest(const char* prog, const std::string
   testing::InitGoogleTest(&gtest_argc, gtest_argv.data());
   if (gtest_argc > 1) {
     return usage_error("unknown GoogleTest flag \"" + std::string(gtest_argv[1]) + "\"");
+  }
+  if (const std::string problem = ReportPathProblem(GTEST_FLAG_GET(output)); !problem.empty()) {
+    std::fprintf(stderr, "%s: error: %s\n", prog, problem.c_str());
+    out.exit_code = 2;
   }
   return out;
 }
@@ -179,7 +234,11 @@ class VectorTest : public testing::Test {
     counts_.replayed.fetch_add(1);
     RecordProperty("vector_id", site_.id);
     std::vector<std::string> problems;
-    replay_(problems);
+    try {
+      replay_(problems);
+    } catch (const std::exception& e) {  // a step the replay cannot read (e.g. a JSON type error)
+      problems.push_back(std::string("malformed vector: ") + e.what());
+    }
     if (!problems.empty()) {
       counts_.mismatched.fetch_add(1);
     }
