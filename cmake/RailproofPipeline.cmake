@@ -48,7 +48,8 @@ foreach(cap ${RAILPROOF_CAPABILITIES})
               --spec ${RAILPROOF_SOURCE_DIR}/spec --work ${CMAKE_BINARY_DIR}/spin/${model}/vectors
               --out ${RAILPROOF_VECTOR_DIR} --jobs 2
       DEPENDS ${_pml} ${_shared} ${_params} ${_tg_spin} ${_tg_engine} ${_tg}/capabilities/${cap}.py
-              ${RAILPROOF_SOURCE_DIR}/spec/schemas/vectors_${cap}.schema.json ${_just}
+              ${RAILPROOF_SOURCE_DIR}/spec/schemas/vectors_${cap}.schema.json
+              ${RAILPROOF_SOURCE_DIR}/spec/schemas/vector_header.schema.json ${_just}
       COMMENT "testgen: trap, boundary and random-walk vectors from models/${model}.pml"
       JOB_POOL railproof_spin VERBATIM)
     list(APPEND _spin_outputs ${_spin_json})
