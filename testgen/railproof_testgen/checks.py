@@ -10,7 +10,6 @@ The checks of each kind build on this module: the lines (``lines.py``), the trai
 """
 from __future__ import annotations
 
-import json
 import re
 import sys
 from dataclasses import dataclass, field
@@ -19,6 +18,7 @@ from pathlib import Path
 import jsonschema
 
 from . import spec as spec_mod
+from .spec import label  # noqa: F401 (the entry names of the checks, shared with the loader)
 from .files import write_atomic
 from .errors import SpecError
 
@@ -96,18 +96,14 @@ class Report:
 
 _VALIDATORS = {}  # schema text -> validator (checking a schema against the meta-schema is slow)
 
-
 def load_schema(spec_dir: Path, name: str):
     path = Path(spec_dir) / "schemas" / name
-    try:
-        text = path.read_text(encoding="utf-8")
-        if text in _VALIDATORS:
-            return _VALIDATORS[text]
-        schema = json.loads(text)
-    except FileNotFoundError:
-        raise SpecError(path, "-", "schema file not found") from None
-    except json.JSONDecodeError as exc:
-        raise SpecError(path, f"line {exc.lineno}", f"malformed JSON: {exc.msg}") from None
+    if not path.exists():
+        raise SpecError(path, "-", "schema file not found")
+    text = spec_mod.read_text(path)
+    if text in _VALIDATORS:
+        return _VALIDATORS[text]
+    schema = spec_mod.parse_json(path, text)
     try:
         jsonschema.Draft202012Validator.check_schema(schema)
     except jsonschema.SchemaError as exc:
@@ -141,16 +137,6 @@ def schema_errors(validator, data, file, report, entry_of=_entry_name):
         report.error(file, entry, f"{where}: {err.message}" if where else err.message)
         n += 1
     return n
-
-
-def label(section, item, index):
-    """Entry name of item `index` of list `section`: ``section[<id or name>]``, else the index."""
-    if isinstance(item, dict):
-        for key in ("id", "name"):
-            v = item.get(key)
-            if isinstance(v, (str, int)) and not isinstance(v, bool) and v != "":
-                return f"{section}[{v}]"
-    return f"{section}[{index}]"
 
 
 def _schema_entry(data, path):
