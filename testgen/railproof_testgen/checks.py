@@ -2,7 +2,7 @@
 (``file: entry: reason``) and their report, schema loading and schema findings, the data
 files of spec/ (loaded, checked against their schema, then by the check of their kind),
 their provenance references, and the conversion of a checked kind to the JSON the C++
-reads (nothing written on any error).
+reads (nothing written on any error, every output written or none: files.write_all).
 
 The checks of each kind build on this module: the lines (``lines.py``), the train types
 (``trains.py``), the timetables (``timetables.py``) and the command ``validate``
@@ -19,7 +19,7 @@ import jsonschema
 
 from . import spec as spec_mod
 from .spec import label  # noqa: F401 (the entry names of the checks, shared with the loader)
-from .files import write_atomic
+from .files import write_all
 from .errors import SpecError
 
 AREAS = ("TG", "MB", "BR", "SC", "RA", "LC", "GN", "FC", "AV")
@@ -279,10 +279,10 @@ def convert(command, args, build, describe, path_of=lambda name: f"{name}.json")
         print(f"{command}: {len(report.errors)} error(s) in {spec_dir / command}; nothing written",
               file=sys.stderr)
         return 1
-    for key, obj in sorted(outputs.items()):
-        path = out_dir / path_of(key)
-        write_atomic(path, spec_mod.render_json(obj))
-        print(f"{command}: {describe(key, obj, path)}")
+    paths = {key: out_dir / path_of(key) for key in sorted(outputs)}
+    write_all({paths[key]: spec_mod.render_json(obj) for key, obj in sorted(outputs.items())})
+    for key, path in paths.items():
+        print(f"{command}: {describe(key, outputs[key], path)}")
     return 0
 
 

@@ -2,7 +2,8 @@
 
 
 class SpecError(Exception):
-    """A malformed, duplicate or dangling entry in spec/ (or in a model/vector file)."""
+    """A malformed, duplicate or dangling entry in spec/ (or in a model/vector file), a file
+    that cannot be read within the loader's limits, or an output that cannot be written."""
 
     def __init__(self, file, entry, reason):
         self.file, self.entry, self.reason = str(file), str(entry), str(reason)

@@ -58,7 +58,7 @@ from pathlib import Path
 
 from . import SPEC_DIR, add_command
 from . import spec as spec_mod
-from .files import write_atomic
+from .files import write_all
 from . import checks
 from .errors import SpecError
 from .checks import label as _label
@@ -864,8 +864,8 @@ def generate(spec_dir, out_dir):
     the count of the others) and writes nothing if any line file is invalid."""
     outputs, report = build(spec_dir)
     checks.raise_first(report)
-    for name, obj in sorted(outputs.items()):
-        write_atomic(Path(out_dir) / f"{name}.json", spec_mod.render_json(obj))
+    write_all({Path(out_dir) / f"{name}.json": spec_mod.render_json(obj)
+               for name, obj in sorted(outputs.items())})
     return sorted(outputs)
 
 

@@ -6,7 +6,7 @@ from pathlib import Path
 
 from . import SPEC_DIR, add_command
 from . import spec as spec_mod
-from .files import write_atomic
+from .files import write_all
 
 _IDENT = re.compile(r"^[a-z][a-z0-9_]*$")
 
@@ -20,6 +20,7 @@ def _cxx_literal(v):
 def generate(spec_dir: Path, out_dir: Path):
     from .validate import validate_spec; validate_spec(spec_dir)  # noqa: E702
     areas = spec_mod.load_parameters(spec_dir)
+    outputs = {}
     for area, data in sorted(areas.items()):
         name = area.lower()
         if Path(data["file"]).stem != name:  # the build declares <file stem>_params.* as outputs
@@ -46,9 +47,10 @@ def generate(spec_dir: Path, out_dir: Path):
             if ns:
                 lines.append(f"}}  // namespace {ns}")
         lines.append(f"}}  // namespace railproof::params::{name}")
-        write_atomic(Path(out_dir) / "include/railproof/generated" / f"{name}_params.hpp",
-                          "\n".join(lines) + "\n")
-        write_atomic(Path(out_dir) / "models" / f"{name}_params.pml", "\n".join(pml) + "\n")
+        outputs[Path(out_dir) / "include/railproof/generated" / f"{name}_params.hpp"] = \
+            "\n".join(lines) + "\n"
+        outputs[Path(out_dir) / "models" / f"{name}_params.pml"] = "\n".join(pml) + "\n"
+    write_all(outputs)
 
 
 def register(sub):
