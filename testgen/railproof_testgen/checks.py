@@ -96,6 +96,15 @@ class Report:
 
 _VALIDATORS = {}  # schema text -> validator (checking a schema against the meta-schema is slow)
 
+# The schemas' "integer" is a whole number written as one: JSON Schema counts 200.0 as an
+# integer, but the generated headers and JSON would carry it as a double (a parameter would
+# become `200.0`, a line field a number the C++ reader refuses as an integer).
+_Validator = jsonschema.validators.extend(
+    jsonschema.Draft202012Validator,
+    type_checker=jsonschema.Draft202012Validator.TYPE_CHECKER.redefine(
+        "integer", lambda _checker, v: isinstance(v, int) and not isinstance(v, bool)))
+
+
 def load_schema(spec_dir: Path, name: str):
     path = Path(spec_dir) / "schemas" / name
     if not path.exists():
@@ -109,7 +118,7 @@ def load_schema(spec_dir: Path, name: str):
     except jsonschema.SchemaError as exc:
         raise SpecError(path, "/".join(map(str, exc.path)) or "-",
                         f"invalid schema: {exc.message}") from None
-    _VALIDATORS[text] = jsonschema.Draft202012Validator(schema)
+    _VALIDATORS[text] = _Validator(schema)
     return _VALIDATORS[text]
 
 
