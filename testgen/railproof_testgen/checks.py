@@ -137,13 +137,22 @@ def _entry_name(data, path):
     return str(head), ".".join(str(p) for p in path[1:])
 
 
+# The keywords of a value's type and range: their message is followed by the description
+# of the schema that sets them, which says the quantity and why its range is what it is.
+_RANGE_KEYWORDS = {"type", "minimum", "maximum", "exclusiveMinimum", "exclusiveMaximum"}
+
+
 def schema_errors(validator, data, file, report, entry_of=_entry_name):
     """Report every schema error as ``file: entry: where: message`` (the entry named by
     entry_of(data, path)); returns their number."""
     n = 0
     for err in sorted(validator.iter_errors(data), key=lambda e: [str(p) for p in e.path]):
         entry, where = entry_of(data, list(err.path))
-        report.error(file, entry, f"{where}: {err.message}" if where else err.message)
+        message = err.message
+        described = err.schema.get("description") if isinstance(err.schema, dict) else None
+        if err.validator in _RANGE_KEYWORDS and described:
+            message += f" ({described})"
+        report.error(file, entry, f"{where}: {message}" if where else message)
         n += 1
     return n
 
