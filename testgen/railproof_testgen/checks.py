@@ -73,17 +73,21 @@ class Report:
 
     errors: list = field(default_factory=list)
     warnings: list = field(default_factory=list)
+    _seen: set = field(default_factory=set, repr=False, compare=False)  # the findings so far
 
     def error(self, file, entry, reason):
-        f = Finding(str(file), str(entry), str(reason))
-        if f not in self.errors:
-            self.errors.append(f)
-        return f
+        return self._add(self.errors, Finding(str(file), str(entry), str(reason)))
 
     def warn(self, file, entry, reason):
-        f = Finding(str(file), str(entry), str(reason))
-        if f not in self.warnings:
-            self.warnings.append(f)
+        return self._add(self.warnings, Finding(str(file), str(entry), str(reason)))
+
+    def _add(self, findings, f):
+        """Each finding once (a set beside the list: the check of a file with many findings
+        stays linear in their number)."""
+        key = (findings is self.errors, f)
+        if key not in self._seen:
+            self._seen.add(key)
+            findings.append(f)
         return f
 
     def print(self, stream=None):
@@ -96,11 +100,41 @@ class Report:
 
 _VALIDATORS = {}  # schema text -> validator (checking a schema against the meta-schema is slow)
 
+def _canonical(v):
+    """A hashable form of a JSON value, equal for values JSON Schema calls equal (1 and 1.0,
+    not True and 1; mappings regardless of key order)."""
+    if isinstance(v, bool):
+        return ("b", v)
+    if isinstance(v, (int, float)):
+        return ("n", v)
+    if isinstance(v, dict):
+        return ("m", frozenset((k, _canonical(x)) for k, x in v.items()))
+    if isinstance(v, list):
+        return ("l", tuple(_canonical(x) for x in v))
+    return ("s", v)
+
+
+def _unique_items(validator, unique, instance, schema):
+    """uniqueItems in time linear in the array: jsonschema compares every pair of an array
+    it cannot sort (mixed types, mappings), which an array of a hundred thousand items
+    makes minutes of work."""
+    if not unique or not validator.is_type(instance, "array"):
+        return
+    seen = set()
+    for item in instance:
+        key = _canonical(item)
+        if key in seen:
+            yield jsonschema.ValidationError(f"{item!r} occurs more than once")
+            return
+        seen.add(key)
+
+
 # The schemas' "integer" is a whole number written as one: JSON Schema counts 200.0 as an
 # integer, but the generated headers and JSON would carry it as a double (a parameter would
 # become `200.0`, a line field a number the C++ reader refuses as an integer).
 _Validator = jsonschema.validators.extend(
     jsonschema.Draft202012Validator,
+    validators={"uniqueItems": _unique_items},
     type_checker=jsonschema.Draft202012Validator.TYPE_CHECKER.redefine(
         "integer", lambda _checker, v: isinstance(v, int) and not isinstance(v, bool)))
 
@@ -209,6 +243,18 @@ def check_data_files(spec_dir, files, schema_name, report, check, load=spec_mod.
         if data_schema_errors(validator, data, f, report):
             continue
         check(f, data)
+
+
+LISTED = 20  # the items a finding lists at most (a long list is cut, with its length)
+
+
+def listing(items, limit=LISTED):
+    """Items joined with ", ", at most `limit` of them and then the count of all: a finding
+    that names what would have been right stays one line of bounded length, however many
+    findings of its kind a file has."""
+    items = list(items)
+    text = ", ".join(map(str, items[:limit]))
+    return text + (f", ... ({len(items)} in all)" if len(items) > limit else "")
 
 
 def check_sources(report, file, entry, sources):
