@@ -286,7 +286,8 @@ def known_assumptions(spec_dir, report):
         except SpecError as exc:
             report.error(exc.file, exc.entry, exc.reason)
             return None
-        for e in data.get("assumptions") or []:
+        entries = data.get("assumptions")
+        for e in entries if isinstance(entries, list) else []:
             if isinstance(e, dict) and isinstance(e.get("id"), str):
                 ids.add(e["id"])
     return ids

@@ -407,9 +407,14 @@ def load_parameters(spec_dir: Path):
         area = data.get("area")
         if not area:
             raise SpecError(f, "area", "missing")
+        if not isinstance(area, str):
+            raise SpecError(f, "area", "must be a string")
         params, bounds = {}, {}
         for section, target in (("parameters", params), ("model_bounds", bounds)):
-            for i, entry in enumerate(data.get(section) or []):
+            entries = data.get(section) or []
+            if not isinstance(entries, list):
+                raise SpecError(f, section, "must be a list")
+            for i, entry in enumerate(entries):
                 if not isinstance(entry, dict) or "id" not in entry or "value" not in entry:
                     raise SpecError(f, f"{section}[{i}]", "entry needs 'id' and 'value'")
                 pid = entry["id"]

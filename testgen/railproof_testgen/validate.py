@@ -130,10 +130,11 @@ def _check_data_args(spec_dir, paths, model, refs, report):
     wheelrail_sim): the same checks as the spec's own, but for the file name."""
     for path in map(Path, paths):
         try:
-            kind = _DATA_CHECKS.get(spec_mod.load_json(path).get("schema"))
+            schema = spec_mod.load_json(path).get("schema")
         except SpecError as exc:
             report.error(exc.file, exc.entry, exc.reason)
             continue
+        kind = _DATA_CHECKS.get(schema) if isinstance(schema, str) else None
         if kind is None:
             report.error(path, "schema", "not one of " + ", ".join(sorted(_DATA_CHECKS)))
         elif kind == "scenarios":
@@ -311,7 +312,7 @@ def _check_requirements(model, report):
         sil = r.get("sil")
         ver = r.get("verification")
         if isinstance(sil, int) and not isinstance(sil, bool) and sil >= 3 \
-                and isinstance(ver, list) and set(ver) == {"review"}:
+                and isinstance(ver, list) and ver and all(v == "review" for v in ver):
             report.error(f, rid, f"SIL {sil} requirement verified by review alone; "
                                  "add model, vectors, unit, analysis or proof")
         if isinstance(r.get("source"), list):
