@@ -10,5 +10,10 @@ class SpecError(Exception):
         super().__init__(f"{self.file}: {self.entry}: {self.reason}")
 
 
+class OutputError(SpecError, OSError):
+    """An output that cannot be written (``file: -: cannot write: reason``): reported like
+    every SpecError, and an OSError for a caller that handles the file system's errors."""
+
+
 class PipelineError(Exception):
     """A pipeline step failed (property violated, tool missing, empty result...)."""

@@ -4,7 +4,7 @@ A command that writes several files writes them as one set (write_all): each is 
 written in full to a temporary file beside it, and only when every one of them is written
 are they renamed over their targets. A failure on the way (an output path that is a
 directory, a directory that cannot be written, a full disk) removes every temporary file
-and every directory made for the set, and is reported as ``file: -: reason`` (SpecError),
+and every directory made for the set, and is reported as ``file: -: reason`` (OutputError),
 with no target touched; the renames that follow cannot fail on the file system's content
 alone, and a failure among them still leaves each target either old or new, never partial.
 """
@@ -15,7 +15,7 @@ import os
 import secrets
 from pathlib import Path
 
-from .errors import SpecError
+from .errors import OutputError
 
 
 def write_all(files, if_changed: bool = True):
@@ -37,7 +37,7 @@ def write_all(files, if_changed: bool = True):
                 staged.append((tmp, path))
                 fh.write(data)
         for tmp, path in staged:
-            os.replace(tmp, path)
+            tmp.replace(path)
     except OSError as exc:
         for tmp, _ in staged:
             tmp.unlink(missing_ok=True)
@@ -46,7 +46,7 @@ def write_all(files, if_changed: bool = True):
                 d.rmdir()
             except OSError:
                 pass
-        raise SpecError(path, "-", f"cannot write: {exc.strerror or exc}") from None
+        raise OutputError(path, "-", f"cannot write: {exc.strerror or exc}") from None
 
 
 def _make_dirs(d: Path, made: list):
