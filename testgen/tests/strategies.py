@@ -4,7 +4,7 @@ the converters (test_input_properties.py, test_converter_properties.py).
 Settings: a fixed number of examples, derived from a fixed seed (derandomize) so that a CI
 run is repeatable and bounded, no deadline (the examples write and check small files), no
 example database left in the tree. A longer, randomised search runs with
-``RAILPROOF_HYPOTHESIS=long`` (spec/design/data.md §1.4).
+``RAILPROOF_HYPOTHESIS=long`` (spec/design/data.md §1.5).
 
 Generators: JSON values within the loader's limits; valid documents of the three converted
 kinds (a line built so that every topology rule holds, a train type satisfying REQ-BR-010,
