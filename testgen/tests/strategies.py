@@ -3,8 +3,9 @@ the converters (test_input_properties.py, test_converter_properties.py).
 
 Settings: a fixed number of examples, derived from a fixed seed (derandomize) so that a CI
 run is repeatable and bounded, no deadline (the examples write and check small files), no
-example database left in the tree. A longer, randomised search runs with
-``RAILPROOF_HYPOTHESIS=long`` (spec/design/data.md §1.5).
+example database, and Hypothesis' caches in a temporary directory removed at the end. A
+longer, randomised search runs with ``RAILPROOF_HYPOTHESIS=long`` (spec/design/data.md
+§1.5).
 
 Generators: JSON values within the loader's limits; valid documents of the three converted
 kinds (a line built so that every topology rule holds, a train type satisfying REQ-BR-010,
@@ -13,8 +14,8 @@ single-field breaks that must be refused, with the entry the finding must name.
 """
 from __future__ import annotations
 
+import atexit
 import copy
-import math
 import os
 import shutil
 import tempfile
@@ -24,8 +25,14 @@ from pathlib import Path
 import yaml
 from hypothesis import HealthCheck, settings
 from hypothesis import strategies as st
+from hypothesis.configuration import set_hypothesis_home_dir
 
-from conftest import FIXTURES, REPO
+
+# Hypothesis keeps caches (constants of the code, Unicode tables) in a directory of the
+# working directory: here one of its own, removed when the tests end.
+_HOME = tempfile.mkdtemp(prefix="railproof-hypothesis-")
+set_hypothesis_home_dir(_HOME)
+atexit.register(shutil.rmtree, _HOME, ignore_errors=True)
 
 settings.register_profile(
     "ci", max_examples=30, deadline=None, derandomize=True, database=None,
@@ -79,7 +86,8 @@ json_documents = st.dictionaries(keys, json_values, max_size=5)
 def paths(doc, where=()):
     """Every path (tuple of keys and indices) to a value inside doc."""
     out = []
-    items = doc.items() if isinstance(doc, dict) else enumerate(doc) if isinstance(doc, list) else ()
+    items = (doc.items() if isinstance(doc, dict)
+             else enumerate(doc) if isinstance(doc, list) else ())
     for k, v in items:
         out.append(where + (k,))
         out.extend(paths(v, where + (k,)))
@@ -342,10 +350,3 @@ def timetable_breaks(doc):
             out.append((entry, ("services", i, "dwell_s"),
                         [-1, 3601, NAN] + ([low] if low >= 0 else [])))
     return out
-
-
-def is_finite_number(v):
-    return isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
-
-
-__all__ = ["FIXTURES", "REPO"]
