@@ -49,6 +49,10 @@ def main(argv=None):
     except (SpecError, PipelineError) as exc:
         print(f"railproof_testgen: error: {exc}", file=sys.stderr)
         return 1
+    except OSError as exc:  # a file no loader or writer of the package reported itself
+        print(f"railproof_testgen: error: {exc.filename or '-'}: -: {exc.strerror or exc}",
+              file=sys.stderr)
+        return 1
     return int(rc or 0)
 
 

@@ -2,7 +2,7 @@
 (``file: entry: reason``) and their report, schema loading and schema findings, the data
 files of spec/ (loaded, checked against their schema, then by the check of their kind),
 their provenance references, and the conversion of a checked kind to the JSON the C++
-reads (nothing written on any error).
+reads (nothing written on any error, every output written or none: files.write_all).
 
 The checks of each kind build on this module: the lines (``lines.py``), the train types
 (``trains.py``), the timetables (``timetables.py``) and the command ``validate``
@@ -10,7 +10,6 @@ The checks of each kind build on this module: the lines (``lines.py``), the trai
 """
 from __future__ import annotations
 
-import json
 import re
 import sys
 from dataclasses import dataclass, field
@@ -19,7 +18,8 @@ from pathlib import Path
 import jsonschema
 
 from . import spec as spec_mod
-from .files import write_atomic
+from .spec import label  # noqa: F401 (the entry names of the checks, shared with the loader)
+from .files import write_all
 from .errors import SpecError
 
 AREAS = ("TG", "MB", "BR", "SC", "RA", "LC", "GN", "FC", "AV")
@@ -73,17 +73,21 @@ class Report:
 
     errors: list = field(default_factory=list)
     warnings: list = field(default_factory=list)
+    _seen: set = field(default_factory=set, repr=False, compare=False)  # the findings so far
 
     def error(self, file, entry, reason):
-        f = Finding(str(file), str(entry), str(reason))
-        if f not in self.errors:
-            self.errors.append(f)
-        return f
+        return self._add(self.errors, Finding(str(file), str(entry), str(reason)))
 
     def warn(self, file, entry, reason):
-        f = Finding(str(file), str(entry), str(reason))
-        if f not in self.warnings:
-            self.warnings.append(f)
+        return self._add(self.warnings, Finding(str(file), str(entry), str(reason)))
+
+    def _add(self, findings, f):
+        """Each finding once (a set beside the list: the check of a file with many findings
+        stays linear in their number)."""
+        key = (findings is self.errors, f)
+        if key not in self._seen:
+            self._seen.add(key)
+            findings.append(f)
         return f
 
     def print(self, stream=None):
@@ -96,24 +100,59 @@ class Report:
 
 _VALIDATORS = {}  # schema text -> validator (checking a schema against the meta-schema is slow)
 
+def _canonical(v):
+    """A hashable form of a JSON value, equal for values JSON Schema calls equal (1 and 1.0,
+    not True and 1; mappings regardless of key order)."""
+    if isinstance(v, bool):
+        return ("b", v)
+    if isinstance(v, (int, float)):
+        return ("n", v)
+    if isinstance(v, dict):
+        return ("m", frozenset((k, _canonical(x)) for k, x in v.items()))
+    if isinstance(v, list):
+        return ("l", tuple(_canonical(x) for x in v))
+    return ("s", v)
+
+
+def _unique_items(validator, unique, instance, schema):
+    """uniqueItems in time linear in the array: jsonschema compares every pair of an array
+    it cannot sort (mixed types, mappings), which an array of a hundred thousand items
+    makes minutes of work."""
+    if not unique or not validator.is_type(instance, "array"):
+        return
+    seen = set()
+    for item in instance:
+        key = _canonical(item)
+        if key in seen:
+            yield jsonschema.ValidationError(f"{item!r} occurs more than once")
+            return
+        seen.add(key)
+
+
+# The schemas' "integer" is a whole number written as one: JSON Schema counts 200.0 as an
+# integer, but the generated headers and JSON would carry it as a double (a parameter would
+# become `200.0`, a line field a number the C++ reader refuses as an integer).
+_Validator = jsonschema.validators.extend(
+    jsonschema.Draft202012Validator,
+    validators={"uniqueItems": _unique_items},
+    type_checker=jsonschema.Draft202012Validator.TYPE_CHECKER.redefine(
+        "integer", lambda _checker, v: isinstance(v, int) and not isinstance(v, bool)))
+
 
 def load_schema(spec_dir: Path, name: str):
     path = Path(spec_dir) / "schemas" / name
-    try:
-        text = path.read_text(encoding="utf-8")
-        if text in _VALIDATORS:
-            return _VALIDATORS[text]
-        schema = json.loads(text)
-    except FileNotFoundError:
-        raise SpecError(path, "-", "schema file not found") from None
-    except json.JSONDecodeError as exc:
-        raise SpecError(path, f"line {exc.lineno}", f"malformed JSON: {exc.msg}") from None
+    if not path.exists():
+        raise SpecError(path, "-", "schema file not found")
+    text = spec_mod.read_text(path)
+    if text in _VALIDATORS:
+        return _VALIDATORS[text]
+    schema = spec_mod.parse_json(path, text)
     try:
         jsonschema.Draft202012Validator.check_schema(schema)
     except jsonschema.SchemaError as exc:
         raise SpecError(path, "/".join(map(str, exc.path)) or "-",
                         f"invalid schema: {exc.message}") from None
-    _VALIDATORS[text] = jsonschema.Draft202012Validator(schema)
+    _VALIDATORS[text] = _Validator(schema)
     return _VALIDATORS[text]
 
 
@@ -132,25 +171,24 @@ def _entry_name(data, path):
     return str(head), ".".join(str(p) for p in path[1:])
 
 
+# The keywords of a value's type and range: their message is followed by the description
+# of the schema that sets them, which says the quantity and why its range is what it is.
+_RANGE_KEYWORDS = {"type", "minimum", "maximum", "exclusiveMinimum", "exclusiveMaximum"}
+
+
 def schema_errors(validator, data, file, report, entry_of=_entry_name):
     """Report every schema error as ``file: entry: where: message`` (the entry named by
     entry_of(data, path)); returns their number."""
     n = 0
     for err in sorted(validator.iter_errors(data), key=lambda e: [str(p) for p in e.path]):
         entry, where = entry_of(data, list(err.path))
-        report.error(file, entry, f"{where}: {err.message}" if where else err.message)
+        message = err.message
+        described = err.schema.get("description") if isinstance(err.schema, dict) else None
+        if err.validator in _RANGE_KEYWORDS and described:
+            message += f" ({described})"
+        report.error(file, entry, f"{where}: {message}" if where else message)
         n += 1
     return n
-
-
-def label(section, item, index):
-    """Entry name of item `index` of list `section`: ``section[<id or name>]``, else the index."""
-    if isinstance(item, dict):
-        for key in ("id", "name"):
-            v = item.get(key)
-            if isinstance(v, (str, int)) and not isinstance(v, bool) and v != "":
-                return f"{section}[{v}]"
-    return f"{section}[{index}]"
 
 
 def _schema_entry(data, path):
@@ -207,6 +245,18 @@ def check_data_files(spec_dir, files, schema_name, report, check, load=spec_mod.
         check(f, data)
 
 
+LISTED = 20  # the items a finding lists at most (a long list is cut, with its length)
+
+
+def listing(items, limit=LISTED):
+    """Items joined with ", ", at most `limit` of them and then the count of all: a finding
+    that names what would have been right stays one line of bounded length, however many
+    findings of its kind a file has."""
+    items = list(items)
+    text = ", ".join(map(str, items[:limit]))
+    return text + (f", ... ({len(items)} in all)" if len(items) > limit else "")
+
+
 def check_sources(report, file, entry, sources):
     """Every source string cites D1-D5 with a section, an ASM-NNN or a named standard;
     returns False if one does not."""
@@ -236,7 +286,8 @@ def known_assumptions(spec_dir, report):
         except SpecError as exc:
             report.error(exc.file, exc.entry, exc.reason)
             return None
-        for e in data.get("assumptions") or []:
+        entries = data.get("assumptions")
+        for e in entries if isinstance(entries, list) else []:
             if isinstance(e, dict) and isinstance(e.get("id"), str):
                 ids.add(e["id"])
     return ids
@@ -293,10 +344,10 @@ def convert(command, args, build, describe, path_of=lambda name: f"{name}.json")
         print(f"{command}: {len(report.errors)} error(s) in {spec_dir / command}; nothing written",
               file=sys.stderr)
         return 1
-    for key, obj in sorted(outputs.items()):
-        path = out_dir / path_of(key)
-        write_atomic(path, spec_mod.render_json(obj))
-        print(f"{command}: {describe(key, obj, path)}")
+    paths = {key: out_dir / path_of(key) for key in sorted(outputs)}
+    write_all({paths[key]: spec_mod.render_json(obj) for key, obj in sorted(outputs.items())})
+    for key, path in paths.items():
+        print(f"{command}: {describe(key, outputs[key], path)}")
     return 0
 
 

@@ -53,12 +53,13 @@ Rules after the schema (entry names such as ``balises[B7]`` or ``gradients[3]``)
 """
 from __future__ import annotations
 
+import bisect
 from decimal import Decimal, InvalidOperation
 from pathlib import Path
 
 from . import SPEC_DIR, add_command
 from . import spec as spec_mod
-from .files import write_atomic
+from .files import write_all
 from . import checks
 from .errors import SpecError
 from .checks import label as _label
@@ -112,6 +113,57 @@ class _CrossingLimits:
     def from_spec(cls, spec_dir):
         return cls(_int_parameter(spec_dir, "LC", "min_warning_time_ms"),
                    _int_parameter(spec_dir, "LC", "default_warning_time_ms"))
+
+
+# The count of virtual blocks of a track when spec/parameters gives no max_blocks (a spec
+# tree without parameters, as the tests' miniature lines): the largest value the parameter
+# schema admits for a count (spec/schemas/parameters.schema.json, $defs/count).
+BLOCKS_LIMIT = 1 << 20
+
+
+def _overlapping(blocks, a, b, disjoint):
+    """The blocks of a track's sorted list that overlap [a, b). Where the blocks do not
+    overlap each other (disjoint: every valid track) the first is found by bisection: a
+    lookup does not walk the track."""
+    if not disjoint:  # overlapping blocks, reported already
+        return [blk for blk in blocks if blk[0] < b and a < blk[1]]
+    k = max(bisect.bisect_right(blocks, (a, float("inf"))) - 1, 0)
+    out = []
+    while k < len(blocks) and blocks[k][0] < b:
+        if a < blocks[k][1]:
+            out.append(blocks[k])
+        k += 1
+    return out
+
+
+class _Sections:
+    """Sections (entry, (a, b), id) of a line in mm, [a, b): the ones holding a point or a
+    range. Where they do not overlap (every valid line) the one is found by bisection, so
+    that checking every stop or crossing against them does not walk them all each time."""
+
+    def __init__(self, items):
+        self.items = sorted(items, key=lambda x: x[1])
+        self.starts = [r[0] for _, r, _ in self.items]
+        self.disjoint = all(x[1][1] <= y[1][0] for x, y in zip(self.items, self.items[1:]))
+
+    def at(self, x, increasing):
+        """The sections a point x lies in: a <= x < b, or for the decreasing direction (in
+        which a section runs from b down to a) a < x <= b."""
+        if not self.disjoint:
+            return [s for s in self.items
+                    if (s[1][0] <= x < s[1][1] if increasing else s[1][0] < x <= s[1][1])]
+        k = (bisect.bisect_right if increasing else bisect.bisect_left)(self.starts, x) - 1
+        if k < 0:
+            return []
+        a, b = self.items[k][1]
+        return [self.items[k]] if (x < b if increasing else x <= b) else []
+
+    def containing(self, a, b):
+        """The sections that contain [a, b]."""
+        if not self.disjoint:
+            return [s for s in self.items if s[1][0] <= a and b <= s[1][1]]
+        k = bisect.bisect_right(self.starts, a) - 1
+        return [self.items[k]] if k >= 0 and b <= self.items[k][1][1] else []
 
 
 def crossing_extent(at_mm, width_mm):
@@ -348,8 +400,10 @@ class _Line:
         return rlines
 
     def _virtual_blocks(self, tracks):
-        """self.blocks: the sorted blocks of each track whose blocks tile it exactly (at
-        most max_blocks)."""
+        """self.blocks: the sorted blocks of each track whose blocks tile it exactly, at most
+        max_blocks of them. The blocks are counted from the entries' ranges and lengths
+        before any is listed: a line of extreme length or tiny blocks is refused by its
+        count, not built block by block."""
         d = self.d
         per_track = {}
         for i, vb in enumerate(d["virtual_blocks"]):
@@ -358,19 +412,19 @@ class _Line:
                 self.err(entry, f"unknown track {vb['track']!r}")
                 continue
             r = self._range(entry, vb)
-            blocks = None if r is None else [r]
+            n = None if r is None else r[1] - r[0]
             if r is not None and "length_m" in vb:
                 n = self.mm(entry, "length_m", vb["length_m"])
                 if n is None:
-                    r = blocks = None
+                    r = None
                 elif (r[1] - r[0]) % n:
                     self.err(entry, f"range {_sec(*r)} is not a whole number of "
                                     f"{_m(n)} m blocks")
-                    r = blocks = None
-                else:
-                    blocks = [(a, a + n) for a in range(r[0], r[1], n)]
-            per_track.setdefault(vb["track"], []).append((entry, r, blocks))
+                    r = None
+            per_track.setdefault(vb["track"], []).append((entry, r, n))
+        limit = self.max_blocks if self.max_blocks is not None else BLOCKS_LIMIT
         self.blocks = {}  # track -> sorted blocks, only for tracks whose blocks are valid
+        self.disjoint = {}  # track -> no two of its blocks overlap
         for tid, t in tracks.items():
             runs = per_track.get(tid, [])
             if not runs:
@@ -380,11 +434,16 @@ class _Line:
                 continue
             self._cover(t["entry"], [(e, r) for e, r, _ in runs], *t["range"],
                         f"virtual blocks of track {tid}")
-            bl = sorted({b for _, _, bs in runs for b in bs})
+            count = sum((r[1] - r[0]) // n for _, r, n in runs)
+            if count > limit:
+                self.err(t["entry"], f"{count} virtual blocks exceed max_blocks {limit} "
+                                     + ("(spec/parameters)" if self.max_blocks is not None
+                                        else "(without spec/parameters: the largest count "
+                                             "spec/schemas/parameters.schema.json admits)"))
+                continue
+            bl = sorted({(a, a + n) for _, r, n in runs for a in range(r[0], r[1], n)})
             self.blocks[tid] = bl
-            if self.max_blocks is not None and len(bl) > self.max_blocks:
-                self.err(t["entry"], f"{len(bl)} virtual blocks exceed max_blocks "
-                                     f"{self.max_blocks} (spec/parameters)")
+            self.disjoint[tid] = all(x[1] <= y[0] for x, y in zip(bl, bl[1:]))
 
     def _profile(self):
         """(gradients, speed limits, curves): gradients and limits cover the line, curves lie
@@ -472,7 +531,7 @@ class _Line:
                 continue
             if p["track"] not in self.blocks:
                 continue  # the track's virtual blocks were rejected above
-            hits = [blk for blk in self.blocks[p["track"]] if blk[0] < r[1] and r[0] < blk[1]]
+            hits = _overlapping(self.blocks[p["track"]], *r, self.disjoint[p["track"]])
             inside = [blk for blk in hits if blk[0] <= r[0] and r[1] <= blk[1]]
             if not hits:
                 self.err(entry, f"point without a virtual block: no virtual block of track "
@@ -480,7 +539,7 @@ class _Line:
                 continue
             if not inside:
                 self.err(entry, f"points {_sec(*r)} span {len(hits)} virtual blocks ("
-                                + ", ".join(_sec(*blk) for blk in hits)
+                                + checks.listing(_sec(*blk) for blk in hits)
                                 + "); points must lie within exactly one virtual block")
                 continue
             blk = inside[0]
@@ -573,6 +632,7 @@ class _Line:
         d = self.d
         stations = []
         plat_by_track = {}
+        nostop_sections = _Sections(nostop)
         for i, st in enumerate(d["stations"]):
             sentry = _label("stations", st, i)
             served = {}
@@ -610,13 +670,10 @@ class _Line:
                                         f"for {'increasing' if rl['inc'] else 'decreasing'} "
                                         "chainage)")
                         continue
-                    for ne, (na, nb), _nid in nostop:
-                        # in running coordinates the stop must not lie in [begin, end)
-                        rs = self._run_pos(stop, rl["inc"])
-                        ra, rb = self._run_sec(na, nb, rl["inc"])
-                        if ra <= rs < rb:
-                            self.err(entry, f"stops.{rid}: stop point {_m(stop)} m lies inside "
-                                            f"no-stop section {ne} {_sec(na, nb)}")
+                    # in running coordinates the stop must not lie in [begin, end)
+                    for ne, (na, nb), _nid in nostop_sections.at(stop, rl["inc"]):
+                        self.err(entry, f"stops.{rid}: stop point {_m(stop)} m lies inside "
+                                        f"no-stop section {ne} {_sec(na, nb)}")
                     if rid in served:
                         self.err(entry, f"stops.{rid}: station {st['name']} already has a stop "
                                         f"for running line {rid} ({served[rid]})")
@@ -650,6 +707,7 @@ class _Line:
         cells_known = all(r is not None for _, r, _ in cells)
         boundaries = {r[0]: e for e, r, _ in cells if r is not None and 0 < r[0] < L}
         handovers, at_boundary = [], {}
+        listed = checks.listing(f"{_m(b)} m" for b in sorted(boundaries)) or "none"
         for i, h in enumerate(d["handovers"]):
             entry = _label("handovers", h, i)
             at = self.mm(entry, "at_m", h["at_m"])
@@ -662,9 +720,7 @@ class _Line:
                 continue  # the cells were rejected above
             if at not in boundaries:
                 self.err(entry, f"handover at {_m(at)} m is not at a boundary between two radio "
-                                "cells (boundaries at: "
-                                + (", ".join(f"{_m(b)} m" for b in sorted(boundaries)) or "none")
-                                + ")")
+                                f"cells (boundaries at: {listed})")
                 continue
             if at in at_boundary:
                 self.err(entry, f"second handover at the cell boundary {_m(at)} m "
@@ -730,9 +786,10 @@ class _Line:
         # no-stop sections: no train of the design length may stand on a crossing (judged
         # only when every no-stop section was valid: one fault, one message)
         if train_mm is not None and len(nostop) == len(self.d.get("no_stop_sections") or []):
+            nostop_sections = _Sections(nostop)
             for c in lcs:
                 a, b = c["range"][0] - train_mm, c["range"][1] + train_mm
-                if not any(na <= a and b <= nb for _, (na, nb), _ in nostop):
+                if not nostop_sections.containing(a, b):
                     self.err(c["entry"], f"no no-stop section contains {_sec(max(a, 0), min(b, L))}"
                                          f" (the crossing {_sec(*c['range'])} widened by the "
                                          f"design train's {_m(train_mm)} m on both sides): a "
@@ -864,8 +921,8 @@ def generate(spec_dir, out_dir):
     the count of the others) and writes nothing if any line file is invalid."""
     outputs, report = build(spec_dir)
     checks.raise_first(report)
-    for name, obj in sorted(outputs.items()):
-        write_atomic(Path(out_dir) / f"{name}.json", spec_mod.render_json(obj))
+    write_all({Path(out_dir) / f"{name}.json": spec_mod.render_json(obj)
+               for name, obj in sorted(outputs.items())})
     return sorted(outputs)
 
 

@@ -58,6 +58,7 @@ class _Timetable:
     def __init__(self, spec_dir, path, data, report, lines, trains):
         self.spec_dir, self.f, self.d, self.report = spec_dir, path, data, report
         self.lines, self.trains = lines, trains
+        self.stations = {}  # running line id -> (station names, name -> index, their listing)
         self.ok = True
 
     def err(self, entry, reason):
@@ -131,6 +132,10 @@ class _Timetable:
 
     def _services(self, line, min_dwell_ms):
         out, ids, last_departure = [], {}, {}
+        rls = {}  # the line's running lines by id (the first of an id), looked up per service
+        for r in (line or {}).get("running_lines", []):
+            rls.setdefault(r["id"], r)
+        listed = checks.listing(rls)
         for i, sv in enumerate(self.d["services"]):
             entry = checks.label("services", sv, i)
             if sv["id"] in ids:
@@ -149,11 +154,10 @@ class _Timetable:
             out.append(item)
             if line is None:
                 continue
-            rl = next((r for r in line["running_lines"] if r["id"] == sv["running_line"]), None)
+            rl = rls.get(sv["running_line"])
             if rl is None:
                 self.err(f"{entry}.running_line", f"unknown running line {sv['running_line']!r} "
-                         f"of line {line['name']} (has: "
-                         + ", ".join(r["id"] for r in line["running_lines"]) + ")")
+                         f"of line {line['name']} (has: {listed})")
                 continue
             origin = self._route(entry, sv, rl, train)
             if origin is None:
@@ -172,8 +176,9 @@ class _Timetable:
         dwell = sv.get("dwell_s")
         by_station = dwell if isinstance(dwell, dict) else {}
         default = dwell if not isinstance(dwell, dict) else dwell.get("default")
+        stops = set(sv["stops"])
         for k in by_station:
-            if k != "default" and k not in sv["stops"]:
+            if k != "default" and k not in stops:
                 self.err(f"{entry}.dwell_s", f"dwell for {k!r}, which is not one of the stops")
         out = []
         for k, station in enumerate(sv["stops"]):
@@ -193,17 +198,23 @@ class _Timetable:
     def _route(self, entry, sv, rl, train):
         """Stations of the service on running line rl checked; returns the origin's name,
         or None if a station is unknown."""
-        names = [s["name"] for s in rl["stations"]]
+        if rl["id"] not in self.stations:
+            names = [s["name"] for s in rl["stations"]]
+            at = {}
+            for i, name in enumerate(names):
+                at.setdefault(name, i)
+            self.stations[rl["id"]] = names, at, checks.listing(names)
+        names, at, listed = self.stations[rl["id"]]
         if len(names) < 2:
             self.err(f"{entry}.running_line", f"running line {rl['id']} has fewer than two "
                                               "stations")
             return None
 
         def index(field, name):
-            if name in names:
-                return names.index(name)
+            if name in at:
+                return at[name]
             self.err(f"{entry}.{field}", f"station {name!r} has no stop on running line "
-                                         f"{rl['id']} (stops: {', '.join(names)})")
+                                         f"{rl['id']} (stops: {listed})")
             return None
 
         first = index("from", sv["from"]) if "from" in sv else 0

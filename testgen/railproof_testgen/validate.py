@@ -41,8 +41,8 @@ from . import spec as spec_mod
 from . import timetables as timetables_mod
 from . import trains as trains_mod
 from .checks import (ASM_ID, CITATION, HAZ_ID, ID_TOKEN, KIND_WORD, KINDS, PREFIX_KIND, REQ_ID,
-                     UR_ID, Report, check_data_files, check_sources, label, load_schema,
-                     missing_data, raise_first, schema_errors)
+                     UR_ID, Report, check_data_files, check_sources, label, listing,
+                     load_schema, missing_data, raise_first, schema_errors)
 from .errors import SpecError
 
 def _check_file_name(report, f, data):
@@ -69,23 +69,25 @@ def check_scenarios(spec_dir, report, lines, files=None):
         if rl is None:
             report.error(f, "running_line", f"unknown running line {data['running_line']!r} on "
                          f"line {line['name']} (has: "
-                         + ", ".join(r["id"] for r in line["running_lines"]) + ")")
+                         + listing(r["id"] for r in line["running_lines"]) + ")")
             return
         names = [s["name"] for s in rl["stations"]]
+        known, listed = set(names), listing(names)
         for i, t in enumerate(data["trains"]):
             for k, stop in enumerate(t.get("stops") or []):
-                if stop["station"] not in names:
+                if stop["station"] not in known:
                     report.error(f, f"{label('trains', t, i)}.stops[{k}]",
                                  f"station: unknown station {stop['station']!r} on running line "
-                                 f"{rl['id']} (has: {', '.join(names)})")
+                                 f"{rl['id']} (has: {listed})")
+        routes = {r["id"] for r in rl["routes"]}
+        siding = any(r["reverse"] and not r["automatic"] for r in rl["routes"])
         for i, fault in enumerate(data.get("faults") or []):
             if fault["type"] != "siding_request":
                 continue
-            if "route" in fault and not any(r["id"] == fault["route"] for r in rl["routes"]):
+            if "route" in fault and fault["route"] not in routes:
                 report.error(f, f"faults[{i}]", f"route: unknown route {fault['route']} on running "
                                                 f"line {rl['id']}")
-            elif "route" not in fault and not any(r["reverse"] and not r["automatic"]
-                                                  for r in rl["routes"]):
+            elif "route" not in fault and not siding:
                 report.error(f, f"faults[{i}]", f"running line {rl['id']} has no siding "
                                                 "(reverse, non-automatic) route")
         out[data["name"]] = data
@@ -128,10 +130,11 @@ def _check_data_args(spec_dir, paths, model, refs, report):
     wheelrail_sim): the same checks as the spec's own, but for the file name."""
     for path in map(Path, paths):
         try:
-            kind = _DATA_CHECKS.get(spec_mod.load_json(path).get("schema"))
+            schema = spec_mod.load_json(path).get("schema")
         except SpecError as exc:
             report.error(exc.file, exc.entry, exc.reason)
             continue
+        kind = _DATA_CHECKS.get(schema) if isinstance(schema, str) else None
         if kind is None:
             report.error(path, "schema", "not one of " + ", ".join(sorted(_DATA_CHECKS)))
         elif kind == "scenarios":
@@ -309,7 +312,7 @@ def _check_requirements(model, report):
         sil = r.get("sil")
         ver = r.get("verification")
         if isinstance(sil, int) and not isinstance(sil, bool) and sil >= 3 \
-                and isinstance(ver, list) and set(ver) == {"review"}:
+                and isinstance(ver, list) and ver and all(v == "review" for v in ver):
             report.error(f, rid, f"SIL {sil} requirement verified by review alone; "
                                  "add model, vectors, unit, analysis or proof")
         if isinstance(r.get("source"), list):

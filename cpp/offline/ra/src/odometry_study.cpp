@@ -16,13 +16,13 @@ namespace railproof::ra::analysis {
 namespace rp = params::ra;
 using offline::InputError;
 
-// D1's figures in km/h/s (spec/parameters/ra.yaml former_*, 0.1 km/h/s) in m/s^2.
+// D1's figures in km/h/s (spec/parameters/ra.yaml former_*, km/h/s x 1000) in m/s^2.
 VehicleAccelBounds D1VehicleBounds() noexcept {
-  constexpr double kKmhSx10 = 1.0 / 36.0;  // 0.1 km/h/s in m/s^2
-  return VehicleAccelBounds{static_cast<double>(rp::former_accel_min_kmh_s_x10) * kKmhSx10,
-                            static_cast<double>(rp::former_accel_max_kmh_s_x10) * kKmhSx10,
-                            static_cast<double>(rp::former_decel_min_kmh_s_x10) * kKmhSx10,
-                            static_cast<double>(rp::former_decel_max_kmh_s_x10) * kKmhSx10};
+  constexpr double kKmhSx1000 = 1.0 / 3600.0;  // 0.001 km/h/s in m/s^2
+  return VehicleAccelBounds{static_cast<double>(rp::former_accel_min_kmh_s_x1000) * kKmhSx1000,
+                            static_cast<double>(rp::former_accel_max_kmh_s_x1000) * kKmhSx1000,
+                            static_cast<double>(rp::former_decel_min_kmh_s_x1000) * kKmhSx1000,
+                            static_cast<double>(rp::former_decel_max_kmh_s_x1000) * kKmhSx1000};
 }
 
 double GravityMS2() noexcept { return static_cast<double>(rp::gravity_mm_s2) / 1000.0; }

@@ -99,8 +99,8 @@ struct OdometryConfig {
   std::int64_t length_correction_ppm = 1000;  // accumulated TG error (REQ-MB-002)
   // baseline method (max/min acceleration) only: vehicle bounds, by default D1's figures
   // (3.3 and 5.2 km/h/s) rounded up to mm/s^2 (the wider envelope)
-  std::int64_t accel_max_mm_s2 = (params::ra::former_accel_max_kmh_s_x10 * 1000 + 35) / 36;
-  std::int64_t decel_max_mm_s2 = (params::ra::former_decel_max_kmh_s_x10 * 1000 + 35) / 36;
+  std::int64_t accel_max_mm_s2 = (params::ra::former_accel_max_kmh_s_x1000 * 10 + 35) / 36;
+  std::int64_t decel_max_mm_s2 = (params::ra::former_decel_max_kmh_s_x1000 * 10 + 35) / 36;
   const OdometrySection* sections = nullptr;  // copied at Create, ordered, contiguous
   int section_count = 0;
   std::int64_t initial_front_mm = 0;          // front at the first cycle (initial balise fix)
