@@ -6,7 +6,7 @@
 // and, per train type (build/gen/trains/*.json), whether the supervision's speed allowance
 // covers the design's error bound (REQ-SC-005). Prints a table; writes JSON and an SVG.
 //
-// Exit status: 0 verdict pass; 1 verdict fail; 2 bad input or error.
+// Exit status: 0 verdict pass; 1 verdict fail; 2 bad usage or bad input (cli.hpp).
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -47,7 +47,7 @@ Options ParseArgs(int argc, char** argv) {
                "and f_1 = f_M (rounded up to a whole Hz); the tool reports static, dynamic and total\n"
                "error, n_2E and the TG constraint f_1 <= f_2E n_1F / n_2E per check speed, the\n"
                "comparison with D3's 0.312 s sampling period and the f_1-n_1F design curve.",
-               "Exit status: 0 pass, 1 fail (a row misses its target), 2 bad input.");
+               "0 pass, 1 fail (a row misses its target)");
   cli.Add("--train-json", o.train_files,
           "train type (build/gen/trains/<name>.json); checks that its allowance speed_error_ppm /\n"
           "speed_error_abs_mm_s covers the design's error bound up to max_speed_kmh +\n"
@@ -218,6 +218,12 @@ int Main(int argc, char** argv) {
   for (const std::string& f : o.train_files) {
     trains.push_back(CheckTrain(f, d));
   }
+  railproof::offline::OutputFiles out;
+  for (const std::string& path : {o.json_path, o.svg_path}) {
+    if (!path.empty()) {
+      out.Reserve(path);
+    }
+  }
   const bool trains_ok = std::all_of(trains.begin(), trains.end(),
                                      [](const TrainRow& t) { return t.check.Covered(); });
   const bool pass = d.MeetsTarget() && d.TgOk() && trains_ok;
@@ -363,11 +369,12 @@ int Main(int argc, char** argv) {
                   worst_dev, worst_at);
     notes.push_back(note);
     j["notes"] = notes;
-    railproof::offline::WriteJsonFile(o.json_path, j);
+    out.WriteJson(o.json_path, j);
   }
   if (!o.svg_path.empty()) {
-    railproof::offline::WriteFileAtomic(o.svg_path, RenderSvg(d, fixed, 10.0 * an::AsymptoteN1F(in)));
+    out.Write(o.svg_path, RenderSvg(d, fixed, 10.0 * an::AsymptoteN1F(in)));
   }
+  out.Commit();
   return pass ? 0 : 1;
 }
 
