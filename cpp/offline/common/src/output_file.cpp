@@ -28,7 +28,8 @@ std::string WriteWhole(const fs::path& tmp, std::string_view text) {
   if (!out) {
     return Reason(errno);
   }
-  if (std::fwrite(text.data(), 1, text.size(), out.get()) != text.size() || std::fflush(out.get()) != 0) {
+  if ((!text.empty() && std::fwrite(text.data(), 1, text.size(), out.get()) != text.size()) ||
+      std::fflush(out.get()) != 0) {
     return Reason(errno != 0 ? errno : EIO);
   }
   if (std::fclose(out.release()) != 0) {
