@@ -16,9 +16,14 @@
 namespace railproof::offline {
 
 std::string OneLine(std::string_view text) {
+  // UTF-8 first: a byte that is not (the parser's "last read" can end inside a character, a
+  // file name need not be UTF-8) becomes U+FFFD, by the library's serialiser and parser
+  const std::string utf8 =
+      nlohmann::json::parse(nlohmann::json(std::string(text)).dump(-1, ' ', false, nlohmann::json::error_handler_t::replace))
+          .get<std::string>();
   std::string out;
-  out.reserve(text.size());
-  for (const char c : text) {
+  out.reserve(utf8.size());
+  for (const char c : utf8) {
     const auto u = static_cast<unsigned char>(c);
     if (u >= 0x20U && u != 0x7FU) {
       out += c;

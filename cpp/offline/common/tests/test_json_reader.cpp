@@ -74,6 +74,10 @@ TEST(JsonReader, TextThatIsNotUtf8OrNotJsonIsNamed) {
             "literal; last read: '\"a\": N'");
   EXPECT_EQ(ParseError("{\"a\": 1e400}"),
             "in.json: invalid JSON: number overflow parsing '1e400'");
+  // the parser's "last read" ends inside a character: the message stays UTF-8
+  EXPECT_EQ(ParseError("[1,\xc3\xa9]"),
+            "in.json: invalid JSON: parse error at line 1, column 4: syntax error while parsing value - invalid "
+            "literal; last read: '1,\xef\xbf\xbd'");
   // a long bad token is cut, the message stays short
   const std::string long_token = "[\"" + std::string(100000, 'x');
   EXPECT_LT(ParseError(long_token).size(), 300U);

@@ -19,8 +19,9 @@
 
 namespace railproof::offline {
 
-// `text` as one line: every control character (a newline or a tab in a key, an identifier or
-// a file name of the input) is written as an escape ("\n", "\t", "\x01").
+// `text` as one line of UTF-8 text: every control character (a newline or a tab in a key, an
+// identifier or a file name of the input) is written as an escape ("\n", "\t", "\x01"), and
+// every byte that is not UTF-8 as U+FFFD.
 std::string OneLine(std::string_view text);
 
 // Any bad input of an offline tool (a data file, an output path): one line "<file>: <entry>:
