@@ -98,7 +98,7 @@ Cli::Cli(std::string tool, const std::string& description, const std::string& ex
   // unknown arguments are collected and reported by Parse (before a missing required option)
   app_.allow_extras();
   app_.option_defaults()->always_capture_default();  // --help shows every option's default
-  app_.footer("Exit status: " + exit_statuses + "; " + kBadUsageStatus);
+  app_.footer("Exit status: " + exit_statuses + ";\n" + kBadUsageStatus);
   app_.get_formatter()->column_width(34);
 }
 

@@ -122,7 +122,7 @@ TEST(Cli, HelpIsGeneratedFromTheOptions) {
   EXPECT_EQ(ParseWith(e.cli, {"-h"}).status, CliResult::Status::kHelp);  // no required check
   const std::string help = d.cli.Help();
   for (const char* part : {"A demonstration.", "Usage: demo", "--name", "a name", "--lead",
-                           "Exit status: 0 done, 1 failed; 2 bad usage or bad input"}) {
+                           "Exit status: 0 done, 1 failed;\n2 bad usage or bad input"}) {
     EXPECT_NE(help.find(part), std::string::npos) << part << " not in\n" << help;
   }
 }

@@ -7,7 +7,6 @@
 // (cli.hpp).
 #include <chrono>
 #include <cstdio>
-#include <filesystem>
 #include <functional>
 #include <iostream>
 #include <string>
@@ -137,12 +136,12 @@ int Main(int argc, char** argv) {
                           {"gap", s["gap"]}});
     }
     Json sweep{{"schema", "railproof/sim-sweep/1"},
-             {"scenario", base.name},
-             {"line", base.line},
-             {"requirements", {"REQ-MB-006", "REQ-MB-008", "REQ-MB-018"}},
-             {"runs", runs},
-             {"gap_grows_with_speed", grows},
-             {"result", all_pass ? "PASS" : "FAIL"}};
+               {"scenario", base.name},
+               {"line", base.line},
+               {"requirements", {"REQ-MB-006", "REQ-MB-008", "REQ-MB-018"}},
+               {"runs", runs},
+               {"gap_grows_with_speed", grows},
+               {"result", all_pass ? "PASS" : "FAIL"}};
     std::printf("gap grows with the leader's speed: %s\n", grows ? "yes" : "no");
     if (!o.summary.empty()) {
       out.WriteJson(o.summary, sweep);
