@@ -22,6 +22,10 @@
 #       railproof_conformance_<cap> replaying the pipeline's vectors, its negative tests, and
 #       the conformance_fault_<F> entries of the faults the registry says the vectors kill.
 #   railproof_bench(SOURCES ... [LINKS ...])                      sources of railproof_bench
+#   railproof_input_fuzz_target(<name> SOURCES ... [INCLUDES ...] [LINKS ...] [SEEDS <dir>...]
+#                               [SECONDS <s>] [DEFINITIONS ...] [DEPENDS ...] [CAPABILITY <cap>]
+#                               [ORACLE_FIRES <seed> <message> ...])
+#       fuzz target of an offline tool's input loader (below)
 
 set_property(GLOBAL PROPERTY RAILPROOF_TARGET_KINDS "")
 
@@ -276,6 +280,83 @@ function(railproof_bench)
   _railproof_resolve(links ${A_LINKS})
   set_property(GLOBAL APPEND PROPERTY RAILPROOF_BENCH_SOURCES ${A_SOURCES})
   set_property(GLOBAL APPEND PROPERTY RAILPROOF_BENCH_LINKS ${links})
+endfunction()
+
+# railproof_input_fuzz_target(<name> SOURCES ... [INCLUDES ...] [LINKS ...] [SEEDS <dir>...]
+#                             [SECONDS <s>] [DEFINITIONS ...] [DEPENDS ...] [CAPABILITY <cap>]
+#                             [ORACLE_FIRES <seed> <message> ...])
+#   The fuzz target of an offline tool's input loader (cpp/offline/<module>/fuzz, spec/design/
+#   data.md §2): SOURCES are the target's file and the loader's sources, compiled into one
+#   executable with the shared harness (cpp/offline/common/fuzz/json_fuzz.hpp); INCLUDES the
+#   include folders of those sources (the offline modules are not linked: their loaders are the
+#   instrumented sources), LINKS the runtime modules and libraries it needs (uninstrumented);
+#   DEPENDS the targets that make its data. Its seeds are the committed corpus fuzz/corpus/<name without fuzz_>/ of the calling
+#   folder and the SEEDS folders (read only: the data the loader is made for).
+#   With RAILPROOF_FUZZ (clang): a libFuzzer executable with coverage and ASan+UBSan, and the
+#   ctest entries (label fuzz) <name>_seeds, every seed once, and <name>_<s>s, s seconds of
+#   fuzzing (default 20) whose new inputs go to a build folder emptied first
+#   (<name>_work_reset). Without it (the g++ ASan+UBSan preset): <name>_replay, which runs
+#   every seed once under the build's sanitizers (ctest <name>_corpus_replay, label
+#   fuzz_replay; replay_main.cpp of the telegram fuzz targets). A longer run:
+#     build/cpp/offline/<module>/<name> -max_total_time=3600 -timeout=10 <new inputs dir> <seeds>
+#   ORACLE_FIRES makes a negative test of the oracle instead (libFuzzer builds): for each
+#   committed seed named, the entry <name>_<seed without .json> passes when the oracle fires on
+#   it with the message "railproof-fuzz: oracle violated: <message>" (a regular expression).
+function(railproof_input_fuzz_target name)
+  cmake_parse_arguments(A "" "SECONDS;CAPABILITY" "SOURCES;INCLUDES;LINKS;SEEDS;DEFINITIONS;DEPENDS;ORACLE_FIRES" ${ARGN})
+  if(NOT A_SECONDS)
+    set(A_SECONDS 20)
+  endif()
+  _railproof_resolve(links ${A_LINKS})
+  string(REGEX REPLACE "^fuzz_" "" corpus ${name})
+  set(seeds ${CMAKE_CURRENT_SOURCE_DIR}/fuzz/corpus/${corpus} ${A_SEEDS})
+  if(RAILPROOF_FUZZ)
+    set(exe ${name})
+    add_executable(${exe} ${A_SOURCES})
+    target_compile_options(${exe} PRIVATE -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all
+                                          -fno-omit-frame-pointer -g -O1)
+    target_link_options(${exe} PRIVATE -fsanitize=fuzzer,address,undefined)
+  else()
+    set(exe ${name}_replay)
+    add_executable(${exe} ${A_SOURCES} ${RAILPROOF_SOURCE_DIR}/cpp/runtime/tg/fuzz/replay_main.cpp)
+  endif()
+  target_include_directories(${exe} PRIVATE ${A_INCLUDES} ${RAILPROOF_SOURCE_DIR}/cpp/offline/common/include
+                             ${RAILPROOF_SOURCE_DIR}/cpp/offline/common/fuzz ${RAILPROOF_GEN_INCLUDE})
+  target_compile_definitions(${exe} PRIVATE ${A_DEFINITIONS})
+  target_link_libraries(${exe} PRIVATE ${links} railproof_options)
+  add_dependencies(${exe} railproof_gen_params ${A_DEPENDS})
+  _railproof_record(${exe} "test:offline:${A_CAPABILITY}" ${links})
+  if(A_ORACLE_FIRES)
+    if(NOT RAILPROOF_FUZZ)
+      return()  # a trap without libFuzzer's handler is a crash to ctest, whatever it printed
+    endif()
+    while(A_ORACLE_FIRES)
+      list(POP_FRONT A_ORACLE_FIRES seed message)
+      string(REGEX REPLACE "\\.json$" "" test ${name}_${seed})
+      add_test(NAME ${test} COMMAND ${exe} ${CMAKE_CURRENT_SOURCE_DIR}/fuzz/corpus/${corpus}/${seed})
+      set_tests_properties(${test} PROPERTIES LABELS fuzz TIMEOUT 60
+        PASS_REGULAR_EXPRESSION "railproof-fuzz: oracle violated: ${message}")
+    endwhile()
+    return()
+  endif()
+  if(NOT RAILPROOF_FUZZ)
+    add_test(NAME ${name}_corpus_replay COMMAND ${exe} ${seeds})
+    set_tests_properties(${name}_corpus_replay PROPERTIES LABELS fuzz_replay
+      PASS_REGULAR_EXPRESSION "railproof-fuzz-replay: [1-9][0-9]* inputs")
+    return()
+  endif()
+  set(work ${CMAKE_CURRENT_BINARY_DIR}/fuzz/work/${corpus})
+  set(artifacts ${CMAKE_CURRENT_BINARY_DIR}/fuzz/artifacts/${corpus})
+  file(MAKE_DIRECTORY ${artifacts})
+  add_test(NAME ${name}_work_reset COMMAND ${CMAKE_COMMAND} -E rm -rf ${work})
+  set_tests_properties(${name}_work_reset PROPERTIES LABELS fuzz FIXTURES_SETUP ${name}_work)
+  add_test(NAME ${name}_seeds COMMAND ${exe} -runs=0 -timeout=10 -artifact_prefix=${artifacts}/ ${seeds})
+  add_test(NAME ${name}_${A_SECONDS}s
+           COMMAND ${exe} -max_total_time=${A_SECONDS} -timeout=10 -print_final_stats=1 -create_missing_dirs=1
+                   -artifact_prefix=${artifacts}/ ${work} ${seeds})
+  math(EXPR timeout "${A_SECONDS} * 3 + 60")
+  set_tests_properties(${name}_seeds ${name}_${A_SECONDS}s PROPERTIES LABELS fuzz TIMEOUT ${timeout})
+  set_tests_properties(${name}_${A_SECONDS}s PROPERTIES FIXTURES_REQUIRED ${name}_work)
 endfunction()
 
 # build/gen/targets.json: every registered target with its kind and direct links.

@@ -65,10 +65,17 @@ TEST(TrainType, RejectsBadJsonNamingFileEntryReason) {
   ExpectRejected(j, {"(top level)", "missing key 'length_mm'"});
   j = TrainJson();
   j["braking"]["emergency_free_running_ms"] = {1500, 500};
-  ExpectRejected(j, {"braking.emergency_free_running_ms", "min 1500 is greater than max 500"});
+  ExpectRejected(j, {"braking.emergency_free_running_ms", "min 1500 ms is greater than max 500 ms"});
   j = TrainJson();
   j["uncertainty"]["odometry_ppm"] = -1;
   ExpectRejected(j, {"uncertainty.odometry_ppm", "outside"});
+  // an absurd maximum speed is refused at load: the design tools loop up to it
+  j = TrainJson();
+  j["max_speed_kmh"] = 100000;
+  ExpectRejected(j, {"bad_train.json: max_speed_kmh: value 100000 km/h is outside [1, 300]"});
+  j = TrainJson();
+  j["braking"]["emergency_overspeed_kmh"] = 31;
+  ExpectRejected(j, {"bad_train.json: braking.emergency_overspeed_kmh: value 31 km/h is outside [0, 30]"});
   j = TrainJson();
   j["supervision"]["speed_error_ppm"] = "2500";
   ExpectRejected(j, {"supervision.speed_error_ppm", "expected an integer"});

@@ -6,8 +6,8 @@
 //
 // Exit status: 0 every margin >= 0 and every check passed; 1 a negative margin (named on
 // stderr), a design-rule finding (REQ-BR-010), a falsified location or a failed NLP/grid
-// cross-check; 2 bad input (including a train type whose speed allowance does not cover
-// the speed-check error, REQ-SC-005) or error.
+// cross-check; 2 bad usage or bad input (cli.hpp; including a train type whose speed
+// allowance does not cover the speed-check error, REQ-SC-005).
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -74,8 +74,8 @@ Options ParseArgs(int argc, char** argv) {
                "boundary and gradient / speed-limit change +- train length) of every running line and\n"
                "every train type, the minimum of L - worst stopping point over the uncertainty set and\n"
                "every state the runtime supervision admits.",
-               "Exit status: 0 all margins >= 0 and all checks passed; 1 a negative margin (named),\n"
-               "a REQ-BR-010 finding, a falsifier violation or a failed NLP/grid cross-check; 2 bad input.");
+               "0 all margins >= 0 and all checks passed; 1 a negative margin (named),\n"
+               "a REQ-BR-010 finding, a falsifier violation or a failed NLP/grid cross-check");
   cli.Add("--line", o.lines, "generated line JSON (build/gen/lines/<line>.json); repeatable")->required();
   cli.Add("--train", o.trains, "train JSON (build/gen/trains/<name>.json); repeatable")->required();
   cli.Add("--json", o.json,
@@ -216,6 +216,15 @@ int Main(int argc, char** argv) {
   std::vector<an::TrainType> trains;
   for (const auto& f : o.trains) {
     trains.push_back(an::LoadTrainType(f));
+  }
+  railproof::offline::OutputFiles out_files;
+  for (const std::string& path : {o.json, o.details}) {
+    if (!path.empty()) {
+      out_files.Reserve(path);
+    }
+  }
+  for (const std::string& dir : {o.svg_dir, o.cases_dir}) {
+    out_files.Directory(dir);
   }
   const an::SpeedErrorModel se = an::ReferenceSpeedErrorModel();
   Json findings = Json::array();
@@ -366,10 +375,9 @@ int Main(int argc, char** argv) {
           }
           cases.push_back(row.fals->regression_case);
           if (!o.cases_dir.empty()) {
-            std::filesystem::create_directories(o.cases_dir);
             std::string name = job.line->name + "_" + job.rl->id + "_" + job.train->name + "_" + an::ToString(row.loc.cls) + "_" +
                                std::to_string(row.loc.stop_limit_mm) + ".json";
-            railproof::offline::WriteJsonFile(std::filesystem::path(o.cases_dir) / name, row.fals->regression_case);
+            out_files.WriteJson(std::filesystem::path(o.cases_dir) / name, row.fals->regression_case);
           }
         }
       }
@@ -486,9 +494,8 @@ int Main(int argc, char** argv) {
                   (r.margin_mm + static_cast<double>(r.loc.class_margin_mm)) / 1000.0, r.loc.id.c_str(), r.method.c_str());
     }
     if (!o.svg_dir.empty()) {
-      std::filesystem::create_directories(o.svg_dir);
-      railproof::offline::WriteFileAtomic(std::filesystem::path(o.svg_dir) / (job.line->name + "_" + job.rl->id + "_" + job.train->name + ".svg"),
-                Svg(job, worst_by_class));
+      out_files.Write(std::filesystem::path(o.svg_dir) / (job.line->name + "_" + job.rl->id + "_" + job.train->name + ".svg"),
+                      Svg(job, worst_by_class));
     }
   }
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
@@ -536,9 +543,10 @@ int Main(int argc, char** argv) {
   } else {
     out["details"] = std::filesystem::path(o.details).filename().string();
     const Json details{{"schema", "railproof/margins-details/1"}, {"skipped", skipped}, {"rows", rows}};
-    railproof::offline::WriteJsonFile(o.details, details);
+    out_files.WriteJson(o.details, details);
   }
-  railproof::offline::WriteJsonFile(o.json, out);
+  out_files.WriteJson(o.json, out);
+  out_files.Commit();
   std::printf("%zu location x train rows (%zu skipped near the line start), grid %.1f s, %zu NLP %.1f s, %zu falsifier %.1f s (%zu violation(s)); total %.1f s: %s\n",
               tasks.size(), skipped_total, grid_wall, nlp_runs, nlp_wall, fals_runs, fals_wall, fals_found, wall,
               pass ? "PASS" : "FAIL");

@@ -8,7 +8,7 @@
 // the supervision's speed allowance covers the design's error bound (REQ-SC-005). Prints a
 // table; writes JSON and an SVG.
 //
-// Exit status: 0 verdict pass; 1 verdict fail; 2 bad input or error.
+// Exit status: 0 verdict pass; 1 verdict fail; 2 bad usage or bad input (cli.hpp).
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -52,8 +52,7 @@ Options ParseArgs(int argc, char** argv) {
                "requirement, n_2E and the TG constraint f_1 <= f_2E n_1F / n_2E per check speed, the\n"
                "comparisons (zero-margin design, D3's 0.312 s sampling period) and the f_1-n_1F\n"
                "design curves.",
-               "Exit status: 0 pass, 1 fail (a row does not keep its margin, the TG constraint or an\n"
-               "allowance fails), 2 bad input.");
+               "0 pass, 1 fail (a row does not keep its margin, the TG constraint or an allowance fails)");
   cli.Add("--train-json", o.train_files,
           "train type (build/gen/trains/<name>.json); checks that its allowance speed_error_ppm /\n"
           "speed_error_abs_mm_s covers the design's error bound up to max_speed_kmh +\n"
@@ -285,6 +284,12 @@ int Main(int argc, char** argv) {
   for (const std::string& f : o.train_files) {
     trains.push_back(CheckTrain(f, d));
   }
+  railproof::offline::OutputFiles out;
+  for (const std::string& path : {o.json_path, o.svg_path}) {
+    if (!path.empty()) {
+      out.Reserve(path);
+    }
+  }
   const bool trains_ok = std::all_of(trains.begin(), trains.end(),
                                      [](const TrainRow& t) { return t.check.Covered(); });
   const bool pass = d.MeetsTarget() && d.TgOk() && trains_ok;
@@ -456,11 +461,12 @@ int Main(int argc, char** argv) {
                   worst_dev, worst_at);
     notes.push_back(note);
     j["notes"] = notes;
-    railproof::offline::WriteJsonFile(o.json_path, j);
+    out.WriteJson(o.json_path, j);
   }
   if (!o.svg_path.empty()) {
-    railproof::offline::WriteFileAtomic(o.svg_path, RenderSvg(d, cmp, 10.0 * an::AsymptoteN1F(r_d)));
+    out.Write(o.svg_path, RenderSvg(d, cmp, 10.0 * an::AsymptoteN1F(r_d)));
   }
+  out.Commit();
   return pass ? 0 : 1;
 }
 

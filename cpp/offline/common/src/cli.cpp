@@ -93,12 +93,12 @@ CLI::Validator InRange(double lo, double hi, bool lo_open) {
 
 CLI::Validator Above(double lo) { return InRange(lo, std::numeric_limits<double>::max(), true); }
 
-Cli::Cli(std::string tool, const std::string& description, const std::string& footer)
+Cli::Cli(std::string tool, const std::string& description, const std::string& exit_statuses)
     : tool_(std::move(tool)), app_(description, tool_) {
   // unknown arguments are collected and reported by Parse (before a missing required option)
   app_.allow_extras();
   app_.option_defaults()->always_capture_default();  // --help shows every option's default
-  app_.footer(footer);
+  app_.footer("Exit status: " + exit_statuses + ";\n" + kBadUsageStatus);
   app_.get_formatter()->column_width(34);
 }
 

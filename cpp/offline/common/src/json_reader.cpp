@@ -1,22 +1,173 @@
 #include "railproof/offline/json_reader.hpp"
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
-#include <fstream>
+#include <cstdio>
 #include <limits>
+#include <memory>
+#include <set>
 #include <sstream>
+#include <stdexcept>
 #include <string>
+#include <system_error>
 #include <utility>
 
 namespace railproof::offline {
 
+std::string OneLine(std::string_view text) {
+  // UTF-8 first: a byte that is not (the parser's "last read" can end inside a character, a
+  // file name need not be UTF-8) becomes U+FFFD, by the library's serialiser and parser
+  const std::string utf8 =
+      nlohmann::json::parse(nlohmann::json(std::string(text)).dump(-1, ' ', false, nlohmann::json::error_handler_t::replace))
+          .get<std::string>();
+  std::string out;
+  out.reserve(utf8.size());
+  for (const char c : utf8) {
+    const auto u = static_cast<unsigned char>(c);
+    if (u >= 0x20U && u != 0x7FU) {
+      out += c;
+    } else if (c == '\n') {
+      out += "\\n";
+    } else if (c == '\r') {
+      out += "\\r";
+    } else if (c == '\t') {
+      out += "\\t";
+    } else {
+      char buf[8];
+      std::snprintf(buf, sizeof buf, "\\x%02x", u);
+      out += buf;
+    }
+  }
+  return out;
+}
+
+namespace {
+
+constexpr std::size_t kQuoteBytes = 64;
+constexpr std::size_t kParserMessageBytes = 200;
+
+// The first `n` bytes of UTF-8 text, not cutting a character.
+std::string_view Cut(std::string_view text, std::size_t n) {
+  if (text.size() <= n) {
+    return text;
+  }
+  while (n > 0 && (static_cast<unsigned char>(text[n]) & 0xC0U) == 0x80U) {
+    --n;
+  }
+  return text.substr(0, n);
+}
+
+std::string CutWithDots(std::string_view text, std::size_t n) {
+  const std::string_view head = Cut(text, n);
+  return std::string(head) + (head.size() < text.size() ? "..." : "");
+}
+
+// The library's message without its "[json.exception.<kind>.<id>] " prefix, cut short.
+std::string LibraryMessage(const nlohmann::json::exception& e) {
+  std::string_view what = e.what();
+  if (what.starts_with("[json.exception.")) {
+    const auto end = what.find("] ");
+    if (end != std::string_view::npos) {
+      what.remove_prefix(end + 2);
+    }
+  }
+  return CutWithDots(what, kParserMessageBytes);
+}
+
+std::string Join(const std::string& path, std::string_view key) {
+  return path.empty() ? std::string(key) : path + "." + std::string(key);
+}
+
+std::string PathForMessage(const std::string& path) { return path.empty() ? std::string("(top level)") : path; }
+
+// The parser callback that keeps what nlohmann's DOM parser does not: one key once per
+// object (the parser keeps the last), and a bounded depth. It follows the path of the value
+// being parsed, in the readers' notation (running_lines[0].blocks_mm[3]), for the message.
+class StructureCheck {
+ public:
+  explicit StructureCheck(const std::string& file) : file_(&file) {}
+
+  bool operator()(int /*depth*/, nlohmann::json::parse_event_t event, nlohmann::json& parsed) {
+    using Event = nlohmann::json::parse_event_t;
+    switch (event) {
+      case Event::object_start:
+      case Event::array_start: {
+        const std::string path = stack_.empty() ? std::string() : ChildPath();
+        if (stack_.size() >= static_cast<std::size_t>(kMaxJsonDepth)) {
+          throw InputError(*file_ + ": " + PathForMessage(path) + ": nested deeper than " +
+                           std::to_string(kMaxJsonDepth) + " levels");
+        }
+        stack_.push_back(Level{event == Event::array_start, path, 0, {}, {}});
+        break;
+      }
+      case Event::key: {
+        Level& level = stack_.back();
+        std::string key = parsed.get<std::string>();
+        if (!level.keys.insert(key).second) {
+          throw InputError(*file_ + ": " + PathForMessage(level.path) + ": duplicate key " + Quoted(key));
+        }
+        level.key = std::move(key);
+        break;
+      }
+      case Event::object_end:
+      case Event::array_end:
+        stack_.pop_back();
+        NextElement();
+        break;
+      case Event::value:
+        NextElement();
+        break;
+    }
+    return true;
+  }
+
+ private:
+  struct Level {
+    bool array = false;
+    std::string path;
+    std::size_t index = 0;  // of the element being parsed (arrays)
+    std::string key;        // of the member being parsed (objects)
+    std::set<std::string, std::less<>> keys;
+  };
+
+  [[nodiscard]] std::string ChildPath() const {
+    const Level& parent = stack_.back();
+    return parent.array ? parent.path + "[" + std::to_string(parent.index) + "]" : Join(parent.path, parent.key);
+  }
+  void NextElement() {
+    if (!stack_.empty() && stack_.back().array) {
+      ++stack_.back().index;
+    }
+  }
+
+  const std::string* file_;
+  std::vector<Level> stack_;
+};
+
+}  // namespace
+
+std::string Quoted(std::string_view text) { return "'" + CutWithDots(text, kQuoteBytes) + "'"; }
+
+std::string FormatNumber(double v) {
+  std::ostringstream os;
+  os << v;
+  return os.str();
+}
+
 nlohmann::json JsonNode::Parse(std::string_view text, const std::string& file) {
+  // UTF-8 first, with the library's own check: serialising the text as a JSON string
+  // (strict error handler) throws at the first byte that is not UTF-8.
   try {
-    return nlohmann::json::parse(text.begin(), text.end());
-  } catch (const nlohmann::json::parse_error& e) {
-    std::string what = e.what();
-    std::replace(what.begin(), what.end(), '\n', ' ');
-    throw InputError(file + ": invalid JSON: " + what);
+    (void)nlohmann::json(std::string(text)).dump();
+  } catch (const nlohmann::json::type_error& e) {
+    throw InputError(file + ": not UTF-8 text: " + LibraryMessage(e));
+  }
+  try {
+    StructureCheck check(file);
+    return nlohmann::json::parse(text.begin(), text.end(), std::ref(check));
+  } catch (const nlohmann::json::exception& e) {  // a syntax error, or a number beyond a double
+    throw InputError(file + ": invalid JSON: " + LibraryMessage(e));
   }
 }
 
@@ -30,9 +181,7 @@ std::string JsonTypeName(const nlohmann::json& value) {
   return value.type_name();
 }
 
-void JsonNode::Fail(const std::string& reason) const {
-  throw InputError(*file_ + ": " + (path_.empty() ? std::string("(top level)") : path_) + ": " + reason);
-}
+void JsonNode::Fail(const std::string& reason) const { throw InputError(*file_ + ": " + PathForMessage(path_) + ": " + reason); }
 
 void JsonNode::RequireType(bool is_expected, std::string_view what) const {
   if (!is_expected) {
@@ -42,17 +191,11 @@ void JsonNode::RequireType(bool is_expected, std::string_view what) const {
 
 void JsonNode::RequireObject() const { RequireType(value_->is_object(), "an object"); }
 
-namespace {
-std::string Join(const std::string& path, std::string_view key) {
-  return path.empty() ? std::string(key) : path + "." + std::string(key);
-}
-}  // namespace
-
 JsonNode JsonNode::Key(std::string_view key) const {
   RequireObject();
   const auto it = value_->find(key);
   if (it == value_->end()) {
-    Fail("missing key '" + std::string(key) + "'");
+    Fail("missing key " + Quoted(key));
   }
   return JsonNode(*it, Join(path_, key), *file_);
 }
@@ -75,7 +218,7 @@ void JsonNode::AllowOnly(std::initializer_list<std::string_view> allowed) const 
   RequireObject();
   for (const auto& item : value_->items()) {
     if (std::find(allowed.begin(), allowed.end(), std::string_view(item.key())) == allowed.end()) {
-      Fail("unknown key '" + item.key() + "'");
+      Fail("unknown key " + Quoted(item.key()));
     }
   }
 }
@@ -129,8 +272,53 @@ std::vector<JsonNode> JsonNode::NonEmptyArray(const std::string& if_empty) const
   return out;
 }
 
+namespace {
+std::string WithUnit(const std::string& value, std::string_view unit) {
+  return unit.empty() ? value : value + " " + std::string(unit);
+}
+}  // namespace
+
+std::int64_t JsonNode::IntIn(std::int64_t lo, std::int64_t hi, std::string_view unit) const {
+  const std::int64_t v = Int();
+  if (v < lo || v > hi) {
+    Fail("value " + WithUnit(std::to_string(v), unit) + " is outside [" + std::to_string(lo) + ", " +
+         std::to_string(hi) + "]");
+  }
+  return v;
+}
+
+double JsonNode::NumberIn(const NumberRange& range, std::string_view unit) const {
+  const double v = Number();
+  if (v < range.lo || (range.lo_open && v == range.lo) || v > range.hi) {
+    Fail("value " + WithUnit(FormatNumber(v), unit) + " is outside " + (range.lo_open ? "(" : "[") +
+         FormatNumber(range.lo) + ", " + FormatNumber(range.hi) + "]");
+  }
+  return v;
+}
+
+std::int64_t JsonNode::ScaledIn(const NumberRange& range, double scale, std::string_view unit) const {
+  constexpr double kExact = 9007199254740992.0;  // 2^53
+  if (!(std::fabs(range.lo * scale) <= kExact && std::fabs(range.hi * scale) <= kExact)) {
+    throw std::logic_error("JsonNode::ScaledIn: range times scale beyond 2^53");
+  }
+  return std::llround(NumberIn(range, unit) * scale);
+}
+
+std::pair<std::int64_t, std::int64_t> JsonNode::IntPairIn(std::int64_t lo, std::int64_t hi, std::string_view unit) const {
+  const auto items = Array();
+  if (items.size() != 2) {
+    Fail("expected [min, max], got " + std::to_string(items.size()) + " element(s)");
+  }
+  const std::pair<std::int64_t, std::int64_t> r{items[0].IntIn(lo, hi, unit), items[1].IntIn(lo, hi, unit)};
+  if (r.first > r.second) {
+    Fail("min " + WithUnit(std::to_string(r.first), unit) + " is greater than max " +
+         WithUnit(std::to_string(r.second), unit));
+  }
+  return r;
+}
+
 JsonNode JsonNode::Labelled(const std::string& label) const {
-  return JsonNode(*value_, path_ + " (" + label + ")", *file_);
+  return JsonNode(*value_, path_ + " (" + CutWithDots(label, kQuoteBytes) + ")", *file_);
 }
 
 JsonDocument::JsonDocument(std::string_view text, const std::string& file)
@@ -141,18 +329,64 @@ JsonDocument::JsonDocument(std::string_view text, const std::string& file, std::
     : JsonDocument(text, file) {
   const JsonNode s = Key("schema");
   if (s.String() != schema) {
-    s.Fail("unsupported schema '" + s.String() + "', expected '" + std::string(schema) + "'" + std::string(note));
+    s.Fail("unsupported schema " + Quoted(s.String()) + ", expected '" + std::string(schema) + "'" + std::string(note));
   }
 }
 
 std::string ReadInputFile(const std::filesystem::path& path, std::string_view what) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    throw InputError(path.string() + ": cannot read" + (what.empty() ? "" : " " + std::string(what)));
+  namespace fs = std::filesystem;
+  const std::string file = path.string();
+  const auto fail = [&](const std::string& reason) -> void {
+    throw InputError(file + ": cannot read " + (what.empty() ? std::string("file") : std::string(what)) + ": " + reason);
+  };
+  std::error_code ec;
+  const fs::file_status st = fs::status(path, ec);
+  if (ec) {
+    fail(ec.message());
   }
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
+  if (fs::is_directory(st)) {
+    fail(std::error_code(EISDIR, std::generic_category()).message());
+  }
+  if (!fs::is_regular_file(st)) {
+    fail("not a regular file");
+  }
+  const auto size = fs::file_size(path, ec);
+  if (ec) {
+    fail(ec.message());
+  }
+  const std::string too_large = "larger than the input limit of " + std::to_string(kMaxInputBytes) + " bytes";
+  if (size > kMaxInputBytes) {
+    fail(too_large);
+  }
+  errno = 0;
+  const std::unique_ptr<std::FILE, int (*)(std::FILE*)> in(std::fopen(file.c_str(), "rb"), &std::fclose);
+  if (!in) {
+    fail(std::error_code(errno, std::generic_category()).message());
+  }
+  // read up to one byte past the limit: a file that grew since its size was taken is refused too
+  std::string text(static_cast<std::size_t>(std::min<std::uintmax_t>(size, kMaxInputBytes)) + 1, '\0');
+  std::size_t got = 0;
+  for (;;) {
+    if (got == text.size()) {
+      if (got > kMaxInputBytes) {
+        fail(too_large);
+      }
+      text.resize(std::min<std::size_t>(2 * text.size(), kMaxInputBytes + 1));
+    }
+    const std::size_t n = std::fread(text.data() + got, 1, text.size() - got, in.get());
+    got += n;
+    if (n == 0) {
+      break;
+    }
+  }
+  if (std::ferror(in.get()) != 0) {
+    fail(std::error_code(errno, std::generic_category()).message());
+  }
+  if (got > kMaxInputBytes) {
+    fail(too_large);
+  }
+  text.resize(got);
+  return text;
 }
 
 }  // namespace railproof::offline

@@ -6,6 +6,7 @@
 #include <string>
 #include <utility>
 
+#include "railproof/core/units.hpp"
 #include "railproof/generated/lc_params.hpp"
 #include "railproof/offline/json_reader.hpp"
 
@@ -121,6 +122,11 @@ void ReadLevelCrossings(const JsonNode& rn, std::int64_t length_mm, RunningLine&
           .Fail("level crossing " + lc.id + ": design warning time " + std::to_string(lc.warning_time_ms) +
                 " ms is below min_warning_time_ms " + std::to_string(lcp::min_warning_time_ms) + " ms");
     }
+    if (lc.warning_time_ms > lcp::max_warning_ms) {
+      n.Key("warning_time_ms")
+          .Fail("level crossing " + lc.id + ": design warning time " + std::to_string(lc.warning_time_ms) +
+                " ms is above max_warning_ms " + std::to_string(lcp::max_warning_ms) + " ms");
+    }
     if (lc.NearMm() <= 0 || lc.FarMm() >= length_mm) {
       n.Fail("level crossing " + lc.id + " [" + Mm(lc.NearMm()) + ", " + Mm(lc.FarMm()) + ") mm (centre " +
              Mm(lc.position_mm) + ", road width " + Mm(lc.width_mm) + ") lies off the line (0, " + Mm(length_mm) + ")");
@@ -147,11 +153,9 @@ RunningLine ReadRunningLine(const JsonNode& rn0, std::set<std::string>& running_
   rl.id = ReadId(rn0, running_ids);
   const JsonNode rn = rn0.Labelled(rl.id);
 
-  const JsonNode len = rn.Key("length_mm");
-  rl.length_mm = len.Int();
-  if (rl.length_mm <= 0) {
-    len.Fail("length must be positive, got " + Mm(rl.length_mm));
-  }
+  // at most the runtime's line coordinate range, so every position and section end (all
+  // within [0, length]) and their sums with a train length stay far from int64 overflow
+  rl.length_mm = rn.Key("length_mm").IntIn(1, core::kMaxPositionMm, "mm");
   const std::int64_t L = rl.length_mm;
 
   // Virtual blocks: boundaries 0 = b0 < b1 < ... < bn = length.

@@ -47,7 +47,7 @@ struct Targets {
 // A parser with one option of every kind, each with a target in `t`.
 struct Demo {
   Targets t;
-  Cli cli{"demo", "A demonstration.", "Exit status: 0, 2 bad usage."};
+  Cli cli{"demo", "A demonstration.", "0 done, 1 failed"};
   Demo() {
     cli.Add("--name", t.name, "a name")->required();
     cli.Add("--out", t.out, "an output");
@@ -121,7 +121,8 @@ TEST(Cli, HelpIsGeneratedFromTheOptions) {
   Demo e;
   EXPECT_EQ(ParseWith(e.cli, {"-h"}).status, CliResult::Status::kHelp);  // no required check
   const std::string help = d.cli.Help();
-  for (const char* part : {"A demonstration.", "Usage: demo", "--name", "a name", "--lead", "Exit status: 0, 2 bad usage."}) {
+  for (const char* part : {"A demonstration.", "Usage: demo", "--name", "a name", "--lead",
+                           "Exit status: 0 done, 1 failed;\n2 bad usage or bad input"}) {
     EXPECT_NE(help.find(part), std::string::npos) << part << " not in\n" << help;
   }
 }

@@ -124,6 +124,15 @@ TEST(SimLineCrossings, RejectsAWarningTimeBelowTheMinimum) {
 }
 
 // @verifies REQ-LC-016
+TEST(SimLineCrossings, RejectsAWarningTimeAboveTheMaximum) {
+  const std::int64_t above = params::lc::max_warning_ms + 1;
+  ExpectCrossingError([above](nlohmann::json& j) { FirstCrossing(j)["warning_time_ms"] = above; },
+                      {"(LC01).warning_time_ms", "level crossing LC01: design warning time " + std::to_string(above) +
+                                                     " ms is above max_warning_ms " +
+                                                     std::to_string(params::lc::max_warning_ms) + " ms"});
+}
+
+// @verifies REQ-LC-016
 TEST(SimLineCrossings, RejectsOverlappingCrossings) {
   // [1502000, 1508000) overlaps [1497000, 1503000)
   ExpectCrossingError([](nlohmann::json& j) { InsertCrossing(j, 1, "LC01b", 1'505'000); },

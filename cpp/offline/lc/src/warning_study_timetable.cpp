@@ -3,6 +3,7 @@
 // stations and train types checked against spec/), and the check that the timetable fits the
 // line and train types the study is given (spec/timetables/README.md, spec/design/data.md).
 #include <cstdio>
+#include <map>
 #include <string>
 
 #include "railproof/lc/analysis/warning_study.hpp"
@@ -25,26 +26,11 @@ std::string FormatClockTime(std::int64_t ms) {
 namespace {
 
 // The guards of the reader: every value the study computes with is an integer within the
-// range its arithmetic is made for (the file may not have seen the validator).
-std::int64_t IntIn(const JsonNode& n, std::int64_t lo, std::int64_t hi, const char* unit) {
-  const std::int64_t v = n.Int();
-  if (v < lo || v > hi) {
-    n.Fail(std::to_string(v) + " " + unit + " is outside [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
-  }
-  return v;
-}
-
-// [min, max] with min <= max (the study draws uniformly between them).
+// range its arithmetic is made for (the file may not have seen the validator); a [min, max]
+// pair has min <= max (the study draws uniformly between them).
 RangeMs RangeIn(const JsonNode& n, std::int64_t lo, std::int64_t hi, const char* unit) {
-  const auto items = n.Array();
-  if (items.size() != 2) {
-    n.Fail("expected [min, max], got " + std::to_string(items.size()) + " element(s)");
-  }
-  RangeMs r{IntIn(items[0], lo, hi, unit), IntIn(items[1], lo, hi, unit)};
-  if (r.min > r.max) {
-    n.Fail("min " + std::to_string(r.min) + " " + unit + " is greater than max " + std::to_string(r.max) + " " + unit);
-  }
-  return r;
+  const auto [min, max] = n.IntPairIn(lo, hi, unit);
+  return RangeMs{min, max};
 }
 
 constexpr std::int64_t kMaxDelayMs = 60'000;
@@ -61,35 +47,40 @@ Timetable ParseTimetable(std::string_view text, const std::string& file) {
   tt.name = root.Key("name").String();
   tt.line = root.Key("line").String();
   tt.title = root.Key("title").String();
-  tt.seed = static_cast<std::uint64_t>(IntIn(root.Key("seed"), 0, std::int64_t{1} << 53, ""));
-  tt.running_time_allowance_percent = IntIn(root.Key("running_time_allowance_percent"), 0, 100, "%");
-  tt.planned_time_step_ms = IntIn(root.Key("planned_time_step_ms"), 1, 300'000, "ms");
+  tt.seed = static_cast<std::uint64_t>(root.Key("seed").IntIn(0, std::int64_t{1} << 53, ""));
+  tt.running_time_allowance_percent = root.Key("running_time_allowance_percent").IntIn(0, 100, "%");
+  tt.planned_time_step_ms = root.Key("planned_time_step_ms").IntIn(1, 300'000, "ms");
   {
     const JsonNode d = root.Key("driver");
     const RangeMs cruise = RangeIn(d.Key("cruise_percent"), 50, 100, "%");
     tt.driver.cruise_min_percent = cruise.min;
     tt.driver.cruise_max_percent = cruise.max;
     tt.driver.start_delay_ms = RangeIn(d.Key("start_delay_ms"), 0, 600'000, "ms");
-    tt.driver.min_dwell_ms = IntIn(d.Key("min_dwell_ms"), 0, kMaxDwellMs, "ms");
+    tt.driver.min_dwell_ms = d.Key("min_dwell_ms").IntIn(0, kMaxDwellMs, "ms");
   }
   {
     const JsonNode c = root.Key("communication");
     tt.comms.uplink_ms = RangeIn(c.Key("uplink_ms"), 0, kMaxDelayMs, "ms");
     tt.comms.downlink_ms = RangeIn(c.Key("downlink_ms"), 0, kMaxDelayMs, "ms");
-    tt.comms.ground_cycle_ms = IntIn(c.Key("ground_cycle_ms"), 1, 10'000, "ms");
-    tt.comms.onboard_cycle_ms = IntIn(c.Key("onboard_cycle_ms"), 1, 10'000, "ms");
+    tt.comms.ground_cycle_ms = c.Key("ground_cycle_ms").IntIn(1, 10'000, "ms");
+    tt.comms.onboard_cycle_ms = c.Key("onboard_cycle_ms").IntIn(1, 10'000, "ms");
     tt.comms.barrier_travel_ms = RangeIn(c.Key("barrier_travel_ms"), 0, kMaxDelayMs, "ms");
     tt.comms.report_latency_ms = RangeIn(c.Key("report_latency_ms"), 0, kMaxDelayMs, "ms");
-    tt.comms.onboard_clock_error_ms = IntIn(c.Key("onboard_clock_error_ms"), 0, 10'000, "ms");
-    tt.comms.gnss_clock_error_ms = IntIn(c.Key("gnss_clock_error_ms"), 0, 10'000, "ms");
+    tt.comms.onboard_clock_error_ms = c.Key("onboard_clock_error_ms").IntIn(0, 10'000, "ms");
+    tt.comms.gnss_clock_error_ms = c.Key("gnss_clock_error_ms").IntIn(0, 10'000, "ms");
   }
   for (const auto& n0 : root.Key("services").NonEmptyArray("no services")) {
     Service s;
     s.id = n0.Key("id").String();
     const JsonNode n = n0.Labelled(s.id);
-    s.train = n.Key("train").String();
+    const JsonNode train = n.Key("train");
+    s.train = train.String();
+    // the study reads <trains-dir>/<train>.json: no other file may be opened
+    if (s.train.empty() || s.train.find_first_of("/\\") != std::string::npos) {
+      train.Fail("train type must be a plain name (file <trains-dir>/<train>.json), got " + offline::Quoted(s.train));
+    }
     s.running_line = n.Key("running_line").String();
-    s.depart_ms = IntIn(n.Key("depart_ms"), 0, 2 * kDayMs - 1, "ms");
+    s.depart_ms = n.Key("depart_ms").IntIn(0, 2 * kDayMs - 1, "ms");
     if (const auto f = n.OptKey("from")) {
       s.from = f->String();
     }
@@ -97,7 +88,7 @@ Timetable ParseTimetable(std::string_view text, const std::string& file) {
       s.to = f->String();
     }
     for (const auto& st : n.Key("stops").Array()) {
-      s.stops.push_back(ServiceStop{st.Key("station").String(), IntIn(st.Key("dwell_ms"), 0, kMaxDwellMs, "ms")});
+      s.stops.push_back(ServiceStop{st.Key("station").String(), st.Key("dwell_ms").IntIn(0, kMaxDwellMs, "ms")});
     }
     tt.services.push_back(s);
   }
@@ -118,6 +109,7 @@ void CheckTimetable(const Timetable& tt, const offline::Line& line, const std::m
   if (tt.line != line.name) {
     FailAt(tt.file, "line", "timetable for line '" + tt.line + "', but the line file is '" + line.name + "' (" + line.file + ")");
   }
+  std::map<const offline::RunningLine*, std::map<std::string, std::size_t>> station_index;
   for (std::size_t i = 0; i < tt.services.size(); ++i) {
     const Service& s = tt.services[i];
     const std::string entry = "services[" + std::to_string(i) + "] (" + s.id + ")";
@@ -142,18 +134,24 @@ void CheckTimetable(const Timetable& tt, const offline::Line& line, const std::m
     if (rl->stations.size() < 2) {
       FailAt(tt.file, entry + ".running_line", "running line '" + s.running_line + "' has fewer than two stations");
     }
+    // station name -> index on the running line, made once per running line (a lookup per stop)
+    auto [cached, fresh] = station_index.try_emplace(rl);
+    if (fresh) {
+      for (std::size_t k = rl->stations.size(); k-- > 0;) {
+        cached->second[rl->stations[k].name] = k;
+      }
+    }
+    const std::map<std::string, std::size_t>& stations = cached->second;
     auto index_of = [&](const std::string& name, const std::string& where) -> std::size_t {
-      for (std::size_t k = 0; k < rl->stations.size(); ++k) {
-        if (rl->stations[k].name == name) {
-          return k;
-        }
+      if (const auto it = stations.find(name); it != stations.end()) {
+        return it->second;
       }
       std::string have;
       for (const auto& st : rl->stations) {
         have += (have.empty() ? "" : ", ") + st.name;
       }
       FailAt(tt.file, entry + "." + where,
-             "station '" + name + "' has no stop on running line " + s.running_line + " (stops: " + have + ")");
+             "station " + offline::Quoted(name) + " has no stop on running line " + s.running_line + " (stops: " + have + ")");
     };
     const std::size_t from = s.from.empty() ? 0 : index_of(s.from, "from");
     const std::size_t to = s.to.empty() ? rl->stations.size() - 1 : index_of(s.to, "to");

@@ -397,6 +397,11 @@ TEST(WarningStudyTimetable, ErrorsNameFileEntryAndReason) {
       {"\"running_line\": \"up\", \"depart_ms\": 21600000", "\"running_line\": \"left\", \"depart_ms\": 21600000",
        {"services[0] (1).running_line", "unknown running line 'left'"}},
       {"\"line\": \"test_line\"", "\"line\": \"d9_line\"", {"tt.json: line", "timetable for line 'd9_line'"}},
+      {"\"train\": \"unit\", \"running_line\": \"up\", \"depart_ms\": 21600000",
+       "\"train\": \"../../etc/unit\", \"running_line\": \"up\", \"depart_ms\": 21600000",
+       {"tt.json: services[0] (1).train: train type must be a plain name (file <trains-dir>/<train>.json), got "
+        "'../../etc/unit'"}},
+      {"\"seed\": 7,", "\"seed\": 7, \"seed\": 8,", {"tt.json: (top level): duplicate key 'seed'"}},
   };
   for (const auto& [from, to, fragments] : edits) {
     ExpectTimetableError(Edit(from, to), fragments);

@@ -4,7 +4,7 @@
 //
 // Exit status: 0 pass; 1 a warning of an on-board or GNSS-time method shorter than the
 // design warning time, or a train braked by a crossing's protection pattern (contract
-// method; each named on stderr); 2 bad input or error.
+// method; each named on stderr); 2 bad usage or bad input (cli.hpp).
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -42,8 +42,8 @@ Options ParseArgs(int argc, char** argv) {
                "with dwell awareness, and dwell-aware from the approach on) and GNSS-time pre-arming;\n"
                "trains the protection pattern would brake are counted (runtime braking patterns and\n"
                "supervision).",
-               "Exit status: 0 pass; 1 a warning of an on-board or GNSS-time method below the design\n"
-               "warning time, or a train braked by the protection pattern (named on stderr); 2 bad input.");
+               "0 pass; 1 a warning of an on-board or GNSS-time method below the design\n"
+               "warning time, or a train braked by the protection pattern (named on stderr)");
   cli.Add("--line", o.line, "generated line JSON (build/gen/lines/<line>.json)")->required();
   cli.Add("--timetable", o.timetable, "generated timetable JSON (build/gen/timetables/<name>.json)")
       ->required();
@@ -80,10 +80,14 @@ int Main(int argc, char** argv) {
     }
     trains.emplace(sv.train, an::LoadTrainType(p));
   }
+  railproof::offline::OutputFiles out;
+  out.Reserve(o.json);
+  out.Directory(o.svg_dir);
+  const railproof::offline::Progress progress("warning_study", o.quiet);
   an::StudyInputs in{&line, &tt, &trains};
   const an::StudyResult r = an::RunStudy(in, [&](std::size_t done, std::size_t total) {
-    if (!o.quiet && (done % 10 == 0 || done == total)) {
-      std::fprintf(stderr, "warning_study: %zu/%zu services\n", done, total);
+    if (done % 10 == 0 || done == total) {
+      progress(std::to_string(done) + "/" + std::to_string(total) + " services");
     }
   });
   auto json = an::StudyJson(in, r, 0.0);
@@ -94,24 +98,24 @@ int Main(int argc, char** argv) {
       an::StudyInputs li = in;
       li.request_lead_ms = lead;
       const an::StudyResult lr = an::RunStudy(li);
-      if (!o.quiet) {
-        std::fprintf(stderr, "warning_study: request lead %.1f s done\n", static_cast<double>(lead) / 1000.0);
-      }
+      char done[64];
+      std::snprintf(done, sizeof done, "request lead %.1f s done", static_cast<double>(lead) / 1000.0);
+      progress(done);
       rows.push_back(an::LeadSensitivityRow(lr, lead));
     }
     json["sensitivity_request_lead"] = rows;
   }
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   json["statistics"]["wall_s"] = std::round(wall * 1000.0) / 1000.0;
-  railproof::offline::WriteJsonFile(o.json, json);
+  out.WriteJson(o.json, json);
   if (!o.svg_dir.empty()) {
-    std::filesystem::create_directories(o.svg_dir);
     for (an::Method m : {an::Method::kTreadle, an::Method::kOnboard, an::Method::kOnboardDwell, an::Method::kOnboardApproach,
                          an::Method::kGnss, an::Method::kGnssReceiveTime}) {
-      railproof::offline::WriteFileAtomic(std::filesystem::path(o.svg_dir) / (std::string("warning_time_") + an::ToString(m) + ".svg"),
-                                      an::HistogramSvg(r, m, line.name));
+      out.Write(std::filesystem::path(o.svg_dir) / (std::string("warning_time_") + an::ToString(m) + ".svg"),
+                an::HistogramSvg(r, m, line.name));
     }
   }
+  out.Commit();
   std::printf("%-30s %6s %7s %7s %7s %7s %8s %6s %7s\n", "method", "n", "min_s", "p05_s", "median", "max_s", "45-74s", "below",
               "braked");
   for (an::Method m : {an::Method::kTreadle, an::Method::kOnboard, an::Method::kOnboardDwell, an::Method::kOnboardApproach,

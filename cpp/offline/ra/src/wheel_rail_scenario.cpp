@@ -10,7 +10,6 @@
 #include <cmath>
 #include <initializer_list>
 #include <span>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -21,16 +20,13 @@ namespace railproof::ra::analysis {
 
 namespace {
 
+// The largest shock sample of an imu_out_of_range fault (m/s^2, about 1000 g: beyond any IMU's
+// measuring range, the fault's purpose; spec/schemas/wheelrail_scenario.schema.json states no
+// bound).
+constexpr double kMaxShockMps2 = 1e4;
+
 // Number in [lo, hi] (inclusive).
-double Ranged(const JsonNode& n, double lo, double hi, const std::string& unit = "") {
-  const double v = n.Number();
-  if (v < lo || v > hi) {
-    std::ostringstream os;
-    os << "value " << v << unit << " outside [" << lo << ", " << hi << "]" << unit;
-    n.Fail(os.str());
-  }
-  return v;
-}
+double Ranged(const JsonNode& n, double lo, double hi) { return n.NumberIn({lo, hi}); }
 
 double RangedKey(const JsonNode& n, std::string_view key, double def, double lo, double hi) {
   const auto k = n.OptKey(key);
@@ -56,11 +52,7 @@ void ReadOptionalNumbers(const JsonNode& n, std::initializer_list<OptionalNumber
   ReadOptionalNumbers(n, std::span(fields.begin(), fields.size()));
 }
 
-std::string Fmt(double v) {
-  std::ostringstream os;
-  os << v;
-  return os.str();
-}
+std::string Fmt(double v) { return offline::FormatNumber(v); }
 
 void ParseVertical(const JsonNode& n, WheelRailScenario& sc) {
   auto& v = sc.vertical;
@@ -107,6 +99,15 @@ void ParseVertical(const JsonNode& n, WheelRailScenario& sc) {
   }
 }
 
+// A curve or an adhesion zone [begin, end) must lie on the vertical alignment, where the
+// simulation has a track: beyond it the section would silently never act.
+void InsideAlignment(const JsonNode& n, const char* what, double begin_m, double end_m, const VerticalAlignment& v) {
+  if (begin_m < v.begin_m || end_m > v.end_m) {
+    n.Fail(std::string(what) + " [" + Fmt(begin_m) + ", " + Fmt(end_m) + ") m lies outside the vertical alignment [" +
+           Fmt(v.begin_m) + ", " + Fmt(v.end_m) + ") m");
+  }
+}
+
 void ParseCurves(const JsonNode& n, WheelRailScenario& sc) {
   for (const auto& e : n.Array()) {
     HorizontalCurve c;
@@ -115,6 +116,7 @@ void ParseCurves(const JsonNode& n, WheelRailScenario& sc) {
     if (c.end_m <= c.begin_m) {
       e.Key("end_m").Fail("not after begin_m");
     }
+    InsideAlignment(e, "curve", c.begin_m, c.end_m, sc.vertical);
     const auto rn = e.Key("radius_m");
     c.radius_m = rn.Number();
     if (std::fabs(c.radius_m) < 100.0 || std::fabs(c.radius_m) > 100000.0) {
@@ -151,6 +153,7 @@ void ParseRail(const JsonNode& n, WheelRailScenario& sc) {
       if (a.end_m <= a.begin_m) {
         e.Key("end_m").Fail("not after begin_m");
       }
+      InsideAlignment(e, "adhesion zone", a.begin_m, a.end_m, sc.vertical);
       a.factor = Ranged(e.Key("factor"), 0.05, 1.0);
       if (const auto f = e.OptKey("from_s")) {
         a.from_s = Ranged(*f, 0.0, 1e6);
@@ -351,7 +354,7 @@ void ParseFaults(const JsonNode& n, WheelRailScenario& sc) {
     f.kind = FaultKind(e.Key("type"));
     f.from_s = Ranged(e.Key("from_s"), 0.0, 1e6);
     const auto tn = e.Key("to_s");
-    f.to_s = tn.Number();
+    f.to_s = Ranged(tn, 0.0, 1e6);
     if (f.to_s <= f.from_s) {
       tn.Fail("not after from_s (negative or zero duration)");
     }
@@ -381,7 +384,7 @@ void ParseFaults(const JsonNode& n, WheelRailScenario& sc) {
       if (f.kind != SensorFaultKind::kImuOutOfRange) {
         v->Fail("only for imu_out_of_range");
       }
-      f.value = v->Number();
+      f.value = Ranged(*v, -kMaxShockMps2, kMaxShockMps2);
     }
     if (const auto note = e.OptKey("note")) {
       f.note = note->String();

@@ -519,6 +519,26 @@ TEST(WheelRailRun, LeadInEndsAtTheInitialFrontAndSpeed) {
   EXPECT_NEAR(run.truth[t0].speed_mps, 10.0, 0.3);
 }
 
+// Curves and adhesion zones off the alignment (where the simulation has no track: they would
+// silently never act), huge fault times and values (converted to integer microseconds), and a
+// key twice: the whole message.
+TEST(WheelRailLoader, RejectsSectionsOffTheAlignmentAndHugeValues) {
+  ExpectError([](auto& j) { j["curves"] = {{{"begin_m", 2900}, {"end_m", 3100}, {"radius_m", 800}}}; },
+              {"bad.json: curves[0]: curve [2900, 3100) m lies outside the vertical alignment [0, 3000) m"});
+  ExpectError([](auto& j) { j["curves"] = {{{"begin_m", -1e300}, {"end_m", 100}, {"radius_m", 800}}}; },
+              {"bad.json: curves[0]: curve [-1e+300, 100) m lies outside the vertical alignment [0, 3000) m"});
+  ExpectError([](auto& j) { j["rail"]["zones"] = {{{"begin_m", 100}, {"end_m", 1e300}, {"factor", 0.3}}}; },
+              {"bad.json: rail.zones[0]: adhesion zone [100, 1e+300) m lies outside the vertical alignment [0, 3000) m"});
+  ExpectError([](auto& j) { j["faults"] = {{{"type", "imu_nan"}, {"from_s", 1}, {"to_s", 1e300}}}; },
+              {"bad.json: faults[0].to_s: value 1e+300 is outside [0, 1e+06]"});
+  ExpectError([](auto& j) { j["faults"] = {{{"type", "imu_out_of_range"}, {"from_s", 1}, {"to_s", 2}, {"value", -1e300}}}; },
+              {"bad.json: faults[0].value: value -1e+300 is outside [-10000, 10000]"});
+  testing::ExpectInputError(
+      [] { (void)ParseWheelRailScenario(R"({"schema": "railproof/wheelrail-scenario/1", "vertical": {"end_m": 1, "end_m": 2}})",
+                                        "bad.json"); },
+      "bad.json", {"bad.json: vertical: duplicate key 'end_m'"});
+}
+
 TEST(WheelRailLoader, TrainLeavingTheAlignmentIsAnError) {
   auto j = BaseScenario(0.0);
   j["initial_front_m"] = 2990;

@@ -13,7 +13,7 @@
 // result JSON, one events JSON and one SVG per scenario, and the summary plots.
 //
 // Exit status: 0 pass; 1 a check failed (named on stderr: scenario, event, figures); 2 bad
-// input or error.
+// usage or bad input (cli.hpp).
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -75,7 +75,7 @@ Options ParseArgs(int argc, char** argv) {
                 "give the typed rejection and stop reason; every train type's readhesion_margin_mm\n"
                 "covers the error model at %lld ms, %.4f deg/s and the steepest gradient of its line.",
                 static_cast<long long>(rp::max_compensation_ms), static_cast<double>(rp::imu_rate_error_udeg_s) / 1e6);
-  off::Cli cli("odometry_study", description, "Exit status: 0 pass, 1 a check failed (named on stderr), 2 bad input or error.");
+  off::Cli cli("odometry_study", description, "0 pass, 1 a check failed (named on stderr)");
   cli.Add("--scenarios", o.scenarios, "scenario JSON files (a FILE, or every *.json of a DIR, sorted)")->required();
   cli.Add("--out-dir", o.out_dir,
           "per scenario <name>.svg (panels) and <name>.events.json; the summary plots\n"
@@ -496,15 +496,11 @@ int Main(int argc, char** argv) {
   for (const auto& t : trains) {
     train_checks.push_back(an::CheckTrainMargin(t, railproof::offline::LoadLine(an::LineOfTrain(t, o.lines_dir))));
   }
-  for (const std::string& dir : {o.out_dir, o.json.empty() ? std::string() : fs::path(o.json).parent_path().string(),
-                                  o.cycles_dir}) {
-    std::error_code ec;
-    if (!dir.empty()) {
-      fs::create_directories(dir, ec);
-    }
-    if (ec) {
-      throw InputError(dir + ": cannot create the output directory (" + ec.message() + ")");
-    }
+  railproof::offline::OutputFiles out;
+  out.Directory(o.out_dir);
+  out.Directory(o.cycles_dir);
+  if (!o.json.empty()) {
+    out.Reserve(o.json);
   }
 
   // ---- scenarios (independent: parallel workers, results in file order)
@@ -519,12 +515,11 @@ int Main(int argc, char** argv) {
       try {
         studies[i] = an::StudyScenario(sc);
         const an::ScenarioStudy& st = *studies[i];
-        railproof::offline::WriteFileAtomic(fs::path(o.out_dir) / (sc.name + ".svg"), an::ScenarioPlotSvg(st));
-        railproof::offline::WriteJsonFile(fs::path(o.out_dir) / (sc.name + ".events.json"), EventsFileJson(st));
+        out.Write(fs::path(o.out_dir) / (sc.name + ".svg"), an::ScenarioPlotSvg(st));
+        out.WriteJson(fs::path(o.out_dir) / (sc.name + ".events.json"), EventsFileJson(st));
         if (!o.cycles_dir.empty()) {
           for (const an::StudyRun* r : {&st.primary, &st.single, &st.baseline}) {
-            railproof::offline::WriteFileAtomic(fs::path(o.cycles_dir) / (sc.name + "." + r->label + ".csv"),
-                                            CyclesCsv(*r, st.sim));
+            out.Write(fs::path(o.cycles_dir) / (sc.name + "." + r->label + ".csv"), CyclesCsv(*r, st.sim));
           }
         }
         const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - ts).count();
@@ -565,10 +560,8 @@ int Main(int argc, char** argv) {
   const auto times = an::StudyTimesS();
   const auto grads = an::StudyGradientsPermille();
   const auto table = an::MarginTable(times, grads, vb);
-  railproof::offline::WriteFileAtomic(fs::path(o.out_dir) / "margin_vs_compensation_time.svg",
-                                  an::MarginPlotSvg(grads, times.back(), vb));
-  railproof::offline::WriteFileAtomic(fs::path(o.out_dir) / "clearing_time_cost.svg",
-                                  an::ClearingPlotSvg(train_checks, 300.0));
+  out.Write(fs::path(o.out_dir) / "margin_vs_compensation_time.svg", an::MarginPlotSvg(grads, times.back(), vb));
+  out.Write(fs::path(o.out_dir) / "clearing_time_cost.svg", an::ClearingPlotSvg(train_checks, 300.0));
 
   // ---- verdict
   std::vector<std::string> failures;
@@ -738,8 +731,9 @@ int Main(int argc, char** argv) {
          "length",
          "baseline extension (margin_table): the former method's occupied-range growth with the rear bound still "
          "moving (worst case); compare with imu_extension (front + rear margin, permanent)"});
-    railproof::offline::WriteJsonFile(o.json, j);
+    out.WriteJson(o.json, j);
   }
+  out.Commit();
 
   // ---- summary
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -3,7 +3,7 @@
 // streams (TG, IMU, balise per 100 ms cycle) with the truth and the slip/slide events.
 // See spec/wheelrail/README.md.
 //
-// Exit status: 0 done; 2 bad input or error.
+// Exit status: 0 done; 2 bad usage or bad input (cli.hpp).
 #include <chrono>
 #include <cstdio>
 #include <string>
@@ -28,9 +28,9 @@ Options ParseArgs(int argc, char** argv) {
       "Simulates a car (body, two bogies, four wheelsets; Box2D, vertical plane) on the\n"
       "scenario's vertical alignment with a slip-dependent adhesion law, traction and brake\n"
       "from the driver schedule, and writes the on-board odometry's sensor streams (TG and\n"
-      "IMU per 100 ms cycle, balise fixes, injected faults) with the truth.",
-      "Prints a summary (distance, speeds, slip/slide events). Exit status: 0 done, 2 bad\n"
-      "input or error.");
+      "IMU per 100 ms cycle, balise fixes, injected faults) with the truth. Prints a summary\n"
+      "(distance, speeds, slip/slide events).",
+      "0 done");
   cli.Add("--scenario", o.scenario, "scenario (format: spec/wheelrail/README.md)")->required();
   cli.Add("--csv", o.csv, "one row per cycle: truth, TG, cycle-mean IMU");
   cli.Add("--json", o.json, "every cycle's TG and IMU samples, balise, truth; the slip/slide events");
@@ -42,20 +42,28 @@ Options ParseArgs(int argc, char** argv) {
 int Main(int argc, char** argv) {
   const Options o = ParseArgs(argc, argv);
   const auto sc = railproof::ra::analysis::LoadWheelRailScenario(o.scenario);
-  auto progress = [&](double t, double total) {
-    if (!o.quiet) {
-      std::fprintf(stderr, "wheelrail_sim: %s: %.0f / %.0f s simulated\n", sc.name.c_str(), t, total);
+  railproof::offline::OutputFiles out;
+  for (const std::string& path : {o.csv, o.json}) {
+    if (!path.empty()) {
+      out.Reserve(path);
     }
+  }
+  const railproof::offline::Progress report("wheelrail_sim", o.quiet);
+  auto progress = [&](double t, double total) {
+    char line[64];
+    std::snprintf(line, sizeof line, ": %.0f / %.0f s simulated", t, total);
+    report(sc.name + line);
   };
   const auto t0 = std::chrono::steady_clock::now();
   const auto run = railproof::ra::analysis::SimulateWheelRail(sc, progress);
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   if (!o.csv.empty()) {
-    railproof::offline::WriteFileAtomic(o.csv, railproof::ra::analysis::WheelRailCsv(run));
+    out.Write(o.csv, railproof::ra::analysis::WheelRailCsv(run));
   }
   if (!o.json.empty()) {
-    railproof::offline::WriteJsonFile(o.json, railproof::ra::analysis::WheelRailJson(sc, run));
+    out.WriteJson(o.json, railproof::ra::analysis::WheelRailJson(sc, run));
   }
+  out.Commit();
   double vmax = 0.0;
   for (const auto& t : run.truth) {
     vmax = std::max(vmax, t.speed_mps);

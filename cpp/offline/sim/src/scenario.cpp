@@ -12,9 +12,9 @@
 #include <cmath>
 #include <limits>
 #include <set>
-#include <sstream>
 #include <string>
 
+#include "railproof/core/units.hpp"
 #include "railproof/generated/mb_params.hpp"
 #include "railproof/generated/tg_params.hpp"
 #include "railproof/offline/json_reader.hpp"
@@ -36,54 +36,39 @@ const char* ToString(FaultType type) {
 
 namespace {
 
+// The ranges of the reader. Times: spec/schemas/scenario.schema.json ($defs/time, at most a
+// week). The schema states no upper bound for the positions, the supervision stand-in and the
+// running resistance; these ranges are stated here: positions within the runtime's line
+// coordinate range (core::kMaxPositionMm, 10,000 km), the supervision margin at most 1 km and
+// its free-running times at most the runtime's supervision times (core::kMaxTimeMs, 60 s), the
+// resistance terms at most 100 N/kN, 10 N/kN per km/h and 1 N/kN per (km/h)^2. Beyond them a
+// value is no longer a scenario the simulation models: near the largest double the braking
+// curves become NaN and would switch the supervision off, and a conversion to mm or ms would
+// leave the integers.
 constexpr double kMaxDurationS = 7.0 * 24.0 * 3600.0;
+constexpr NumberRange kTime{0.0, kMaxDurationS};
+constexpr NumberRange kPosition{0.0, static_cast<double>(core::kMaxPositionMm) / 1000.0};
+constexpr NumberRange kSupervisionMargin{0.0, 1000.0};
+constexpr NumberRange kFreeRunning{0.0, static_cast<double>(core::kMaxTimeMs) / 1000.0};
+constexpr NumberRange kSpeed{0.0, 400.0, true};  // km/h
 
-std::string Num(double v) {
-  std::ostringstream os;
-  os << v;
-  return os.str();
-}
+double Positive(const JsonNode& n, double max) { return n.NumberIn({0.0, max, true}); }
 
-double Positive(const JsonNode& n, double max = std::numeric_limits<double>::max()) {
-  const double v = n.Number();
-  if (!(v > 0.0) || v > max) {
-    n.Fail("must be positive" + (max < std::numeric_limits<double>::max() ? " and at most " + Num(max) : std::string()) +
-           ", got " + Num(v));
+double Probability(const JsonNode& n) { return n.NumberIn({0.0, 1.0}); }
+
+std::int64_t SecondsToMs(const JsonNode& n) { return n.ScaledIn(kTime, 1000.0, "s"); }
+
+std::int64_t MetresToMm(const JsonNode& n) { return n.ScaledIn(kPosition, 1000.0, "m"); }
+
+std::int64_t PositiveMs(const JsonNode& n) { return n.IntIn(1, 3'600'000, "ms"); }
+
+// A time of the scenario that must fall before its end: what comes later would silently
+// never happen while the run reports its result.
+void BeforeEnd(const JsonNode& n, std::int64_t ms, std::int64_t duration_ms, const std::string& what) {
+  if (ms >= duration_ms) {
+    n.Fail(what + " at " + FormatNumber(static_cast<double>(ms) / 1000.0) + " s, at or after the end of the scenario (duration_s " +
+           FormatNumber(static_cast<double>(duration_ms) / 1000.0) + ")");
   }
-  return v;
-}
-
-double NonNegative(const JsonNode& n) {
-  const double v = n.Number();
-  if (v < 0.0) {
-    n.Fail("must not be negative, got " + Num(v));
-  }
-  return v;
-}
-
-double Probability(const JsonNode& n) {
-  const double v = n.Number();
-  if (v < 0.0 || v > 1.0) {
-    n.Fail("must be a probability in [0, 1], got " + Num(v));
-  }
-  return v;
-}
-
-std::int64_t SecondsToMs(const JsonNode& n, double s) {
-  if (s > kMaxDurationS) {
-    n.Fail("time " + Num(s) + " s too large");
-  }
-  return static_cast<std::int64_t>(std::llround(s * 1000.0));
-}
-
-std::int64_t MetresToMm(double m) { return static_cast<std::int64_t>(std::llround(m * 1000.0)); }
-
-std::int64_t PositiveMs(const JsonNode& n) {
-  const std::int64_t v = n.Int();
-  if (v <= 0 || v > 3600000) {
-    n.Fail("must be a positive number of milliseconds up to 3600000, got " + std::to_string(v));
-  }
-  return v;
 }
 
 TrainSpec ReadTrain(const JsonNode& n, const std::string& entry) {
@@ -96,7 +81,7 @@ TrainSpec ReadTrain(const JsonNode& n, const std::string& entry) {
   }
   t.id = static_cast<std::uint16_t>(id);
   t.performance.length_m = Positive(n.Key("length_m"), 2000.0);
-  t.performance.max_speed_mps = Positive(n.Key("max_speed_kmh"), 400.0) / 3.6;
+  t.performance.max_speed_mps = n.Key("max_speed_kmh").NumberIn(kSpeed, "km/h") / 3.6;
   t.performance.accel_mps2 = Positive(n.Key("accel_mps2"), 5.0);
   t.performance.service_decel_mps2 = Positive(n.Key("service_decel_mps2"), 5.0);
   const JsonNode en = n.Key("emergency_decel_mps2");
@@ -104,26 +89,27 @@ TrainSpec ReadTrain(const JsonNode& n, const std::string& entry) {
   if (t.performance.emergency_decel_mps2 < t.performance.service_decel_mps2) {
     en.Fail("emergency deceleration below the service deceleration");
   }
-  t.initial_front_mm = MetresToMm(NonNegative(n.Key("initial_front_m")));
+  t.initial_front_mm = MetresToMm(n.Key("initial_front_m"));
   if (auto e = n.OptKey("enter_s")) {
-    t.enter_ms = SecondsToMs(*e, NonNegative(*e));
+    t.enter_ms = SecondsToMs(*e);
   }
   const JsonNode dn = n.Key("depart_s");
-  t.depart_ms = SecondsToMs(dn, NonNegative(dn));
+  t.depart_ms = SecondsToMs(dn);
   if (t.depart_ms < t.enter_ms) {
     dn.Fail("departure before the train enters (enter_s)");
   }
   if (auto sn = n.OptKey("stops")) {
     for (const auto& s : sn->Array()) {
-      const JsonNode dw = s.Key("dwell_s");
-      t.stops.push_back(StopSpec{s.Key("station").String(), SecondsToMs(dw, NonNegative(dw))});
+      t.stops.push_back(StopSpec{s.Key("station").String(), SecondsToMs(s.Key("dwell_s"))});
     }
   }
   if (auto c = n.OptKey("speed_cap_kmh")) {
-    t.speed_cap_mps = Positive(*c, 400.0) / 3.6;
+    t.speed_cap_mps = c->NumberIn(kSpeed, "km/h") / 3.6;
   }
   if (auto r = n.OptKey("resistance")) {
-    t.performance.resistance = Resistance{NonNegative(r->Key("a0")), NonNegative(r->Key("a1")), NonNegative(r->Key("a2"))};
+    t.performance.resistance = Resistance{r->Key("a0").NumberIn({0.0, 100.0}, "N/kN"),
+                                          r->Key("a1").NumberIn({0.0, 10.0}, "N/kN per km/h"),
+                                          r->Key("a2").NumberIn({0.0, 1.0}, "N/kN per (km/h)^2")};
   }
   return t;
 }
@@ -152,14 +138,14 @@ FaultSpec ReadFault(const JsonNode& n, const std::string& entry) {
     f.train = static_cast<std::uint16_t>(id);
   } else if (f.type == FaultType::kPossession || f.type == FaultType::kSpeedRestriction) {
     const bool possession = f.type == FaultType::kPossession;
-    f.begin_mm = MetresToMm(NonNegative(n.Key("begin_m")));
+    f.begin_mm = MetresToMm(n.Key("begin_m"));
     const JsonNode en = n.Key("end_m");
-    f.end_mm = MetresToMm(NonNegative(en));
+    f.end_mm = MetresToMm(en);
     if (f.end_mm <= f.begin_mm) {
       en.Fail(std::string(possession ? "possession" : "restriction") + " end not after its begin");
     }
     if (!possession) {
-      f.speed_mps = Positive(n.Key("speed_kmh"), 400.0) / 3.6;
+      f.speed_mps = n.Key("speed_kmh").NumberIn(kSpeed, "km/h") / 3.6;
     }
   } else if (auto r = n.OptKey("route")) {  // a siding request naming its route
     f.route = r->Int();
@@ -167,10 +153,9 @@ FaultSpec ReadFault(const JsonNode& n, const std::string& entry) {
       r->Fail("route id must be positive");
     }
   }
-  const JsonNode fn = n.Key("from_s");
-  f.from_ms = SecondsToMs(fn, NonNegative(fn));
+  f.from_ms = SecondsToMs(n.Key("from_s"));
   const JsonNode ton = n.Key("to_s");
-  f.to_ms = SecondsToMs(ton, NonNegative(ton));
+  f.to_ms = SecondsToMs(ton);
   if (f.to_ms <= f.from_ms) {
     ton.Fail("window end not after its start (from_s)");
   }
@@ -194,18 +179,13 @@ Scenario ParseScenario(std::string_view text, const std::string& file) {
   }
   sc.running_line = root.Key("running_line").String();
   const JsonNode dur = root.Key("duration_s");
-  sc.duration_ms = SecondsToMs(dur, Positive(dur, kMaxDurationS));
+  sc.duration_ms = dur.ScaledIn({0.0, kMaxDurationS, true}, 1000.0, "s");
 
-  sc.step_ms = root.Has("step_ms") ? PositiveMs(root.Key("step_ms")) : 100;
-  if (sc.step_ms > 1000) {
-    root.Key("step_ms").Fail("step must be at most 1000 ms");
+  sc.step_ms = root.Has("step_ms") ? root.Key("step_ms").IntIn(1, 1000, "ms") : 100;
+  if (sc.duration_ms < sc.step_ms) {
+    dur.Fail("the scenario is shorter than one step (step_ms " + std::to_string(sc.step_ms) + ")");
   }
-  const JsonNode seed = root.Key("seed");
-  const std::int64_t sv = seed.Int();
-  if (sv < 0) {
-    seed.Fail("seed must not be negative");
-  }
-  sc.seed = static_cast<std::uint64_t>(sv);
+  sc.seed = static_cast<std::uint64_t>(root.Key("seed").IntIn(0, std::numeric_limits<std::int64_t>::max()));
 
   sc.ground_cycle_ms = root.Has("ground_cycle_ms") ? PositiveMs(root.Key("ground_cycle_ms")) : mb::ground_cycle_ms;
   sc.report_period_ms = root.Has("report_period_ms") ? PositiveMs(root.Key("report_period_ms")) : mb::report_period_ms;
@@ -227,7 +207,7 @@ Scenario ParseScenario(std::string_view text, const std::string& file) {
     }
   }
   if (auto h = root.OptKey("handover_secure_ahead_m")) {
-    sc.handover_secure_ahead_m = NonNegative(*h);
+    sc.handover_secure_ahead_m = h->NumberIn(kPosition, "m");
   }
   if (auto b = root.OptKey("boundary_accepted")) {
     sc.boundary_accepted = b->Bool();
@@ -246,26 +226,23 @@ Scenario ParseScenario(std::string_view text, const std::string& file) {
       sc.channel.corrupt_probability = Probability(*c);
     }
     const JsonNode mx = ch.Key("max_delay_ms");
-    sc.channel.max_delay_ms = mx.Int();
+    sc.channel.max_delay_ms = mx.IntIn(0, 60'000, "ms");
     if (auto mn = ch.OptKey("min_delay_ms")) {
-      sc.channel.min_delay_ms = mn->Int();
-      if (sc.channel.min_delay_ms < 0) {
-        mn->Fail("delay must not be negative");
-      }
+      sc.channel.min_delay_ms = mn->IntIn(0, 60'000, "ms");
     }
-    if (sc.channel.max_delay_ms < sc.channel.min_delay_ms || sc.channel.max_delay_ms > 60000) {
+    if (sc.channel.max_delay_ms < sc.channel.min_delay_ms) {
       mx.Fail("max_delay_ms must lie in [min_delay_ms, 60000], got " + std::to_string(sc.channel.max_delay_ms));
     }
   }
   if (auto sv2 = root.OptKey("supervision")) {
     if (auto m = sv2->OptKey("margin_m")) {
-      sc.supervision.margin_m = NonNegative(*m);
+      sc.supervision.margin_m = m->NumberIn(kSupervisionMargin, "m");
     }
     if (auto m = sv2->OptKey("free_running_s")) {
-      sc.supervision.free_running_s = NonNegative(*m);
+      sc.supervision.free_running_s = m->NumberIn(kFreeRunning, "s");
     }
     if (auto m = sv2->OptKey("emergency_free_running_s")) {
-      sc.supervision.emergency_free_running_s = NonNegative(*m);
+      sc.supervision.emergency_free_running_s = m->NumberIn(kFreeRunning, "s");
     }
   }
 
@@ -276,11 +253,7 @@ Scenario ParseScenario(std::string_view text, const std::string& file) {
       std::int64_t count = 1;
       double interval_s = 0.0;
       if (auto rp = n.OptKey("repeat")) {
-        const JsonNode cn = rp->Key("count");
-        count = cn.Int();
-        if (count < 1 || count > 1000) {
-          cn.Fail("count must lie in 1..1000");
-        }
+        count = rp->Key("count").IntIn(1, 1000);
         interval_s = Positive(rp->Key("interval_s"), kMaxDurationS);
       }
       for (std::int64_t k = 0; k < count; ++k) {
@@ -296,6 +269,8 @@ Scenario ParseScenario(std::string_view text, const std::string& file) {
         if (k > 0) {
           t.entry = n.Path() + " copy " + std::to_string(k);
         }
+        BeforeEnd(k > 0 ? n.Key("repeat").Key("interval_s") : n.Key("depart_s"), t.depart_ms, sc.duration_ms,
+                  (k > 0 ? "copy " + std::to_string(k) + " departs" : std::string("the train departs")));
         if (!ids.insert(t.id).second) {
           n.Key("id").Fail("duplicate train id " + std::to_string(t.id));
         }
@@ -306,6 +281,7 @@ Scenario ParseScenario(std::string_view text, const std::string& file) {
   if (auto fn = root.OptKey("faults")) {
     for (const auto& n : fn->Array()) {
       FaultSpec f = ReadFault(n, n.Path());
+      BeforeEnd(n.Key("from_s"), f.from_ms, sc.duration_ms, "the fault begins");
       if (f.train && std::none_of(sc.trains.begin(), sc.trains.end(), [&](const TrainSpec& t) { return t.id == *f.train; })) {
         n.Key("train").Fail("unknown train " + std::to_string(*f.train));
       }
@@ -325,10 +301,9 @@ Scenario ParseScenario(std::string_view text, const std::string& file) {
     if (g.leader == g.follower) {
       gn->Key("follower").Fail("follower equals leader");
     }
-    const JsonNode f = gn->Key("from_s");
-    g.from_ms = SecondsToMs(f, NonNegative(f));
+    g.from_ms = SecondsToMs(gn->Key("from_s"));
     const JsonNode t = gn->Key("to_s");
-    g.to_ms = SecondsToMs(t, NonNegative(t));
+    g.to_ms = SecondsToMs(t);
     if (g.to_ms <= g.from_ms || g.to_ms > sc.duration_ms) {
       t.Fail("gap window must end after from_s and within duration_s");
     }

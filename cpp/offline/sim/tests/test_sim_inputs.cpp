@@ -101,6 +101,17 @@ TEST(SimLineLoader, RejectsBadGeometry) {
   ExpectLineError([](auto& j) { Up(j)["system_boundary_mm"] = 0; }, {"system_boundary_mm", "lies off the line"});
 }
 
+// Values beyond the range the simulation computes with, and a key twice: the whole message.
+// @verifies REQ-MB-020
+TEST(SimLineLoader, RejectsOutOfRangeValuesAndDuplicateKeys) {
+  ExpectLineError([](auto& j) { Up(j)["length_mm"] = 20'000'000'000; },
+                  {"bad_line.json: running_lines[0] (up).length_mm: value 20000000000 mm is outside [1, 10000000000]"});
+  const std::string text = TestLineJson().dump();
+  const std::string twice = "{\"name\": \"x\", " + text.substr(1);  // "name" now stands twice
+  testing::ExpectInputError([&] { (void)ParseLine(twice, "bad_line.json"); }, "bad_line.json",
+                            {"bad_line.json: (top level): duplicate key 'name'"});
+}
+
 // @verifies REQ-MB-020
 TEST(SimLineLoader, RejectsAnUnknownRunningLine) {
   const Line line = LoadLine(DataDir() / "sim_test_line.json");
@@ -169,6 +180,7 @@ void ExpectScenarioError(const std::function<void(nlohmann::json&)>& mutate, con
 
 TEST(SimScenarioFile, ParsesAndFillsDefaultsFromTheParameters) {
   nlohmann::json j = MinimalScenario();
+  j["duration_s"] = 600;  // the copies depart before the end
   j["trains"][0]["repeat"] = {{"count", 3}, {"interval_s", 120}};
   j["trains"][0]["stops"] = {{{"station", "A"}, {"dwell_s", 30}}};
   j["faults"] = {{{"type", "radio_loss"}, {"train", 3}, {"from_s", 10}, {"to_s", 20}},
@@ -189,7 +201,7 @@ TEST(SimScenarioFile, ParsesAndFillsDefaultsFromTheParameters) {
 
 TEST(SimScenarioFile, BadScenarioFilesGiveOneLineErrorsNamingTheEntry) {
   // unknown keys are the schema's (railproof_testgen validate); the reader guards the values
-  ExpectScenarioError([](auto& j) { j["trains"][0]["length_m"] = 1e300; }, {"trains[0].length_m", "at most 2000"});
+  ExpectScenarioError([](auto& j) { j["trains"][0]["length_m"] = 1e300; }, {"trains[0].length_m", "value 1e+300 is outside (0, 2000]"});
   ExpectScenarioError([](auto& j) { j.erase("seed"); }, {"missing key 'seed'"});
   ExpectScenarioError([](auto& j) { j["channel"]["loss_probability"] = 1.5; }, {"channel.loss_probability", "probability"});
   ExpectScenarioError([](auto& j) { j["channel"]["max_delay_ms"] = -1; }, {"channel.max_delay_ms"});
@@ -218,6 +230,39 @@ TEST(SimScenarioFile, BadScenarioFilesGiveOneLineErrorsNamingTheEntry) {
   ExpectScenarioError([](auto& j) { j["line"] = "other_line"; }, {"line: the scenario names line 'other_line'"}, true);
   ExpectScenarioError([](auto& j) { j["faults"] = {{{"type", "siding_request"}, {"route", 7}, {"from_s", 1}, {"to_s", 2}}}; },
                       {"faults[0]", "unknown route 7"}, true);
+}
+
+// Huge but finite values: refused before a conversion to mm or ms, and before they can turn
+// the braking curves into NaN (the supervision off) or put a train or a fault after the end
+// of the run, where it would silently never act while the run reports PASS.
+TEST(SimScenarioFile, HugeValuesAndTimesAfterTheEndAreRefused) {
+  ExpectScenarioError([](auto& j) { j["trains"][0]["initial_front_m"] = 1e300; },
+                      {"bad_scenario.json: trains[0].initial_front_m: value 1e+300 m is outside [0, 1e+07]"});
+  ExpectScenarioError([](auto& j) { j["supervision"] = {{"emergency_free_running_s", 1e300}}; },
+                      {"bad_scenario.json: supervision.emergency_free_running_s: value 1e+300 s is outside [0, 60]"});
+  ExpectScenarioError([](auto& j) { j["supervision"] = {{"margin_m", 1e9}}; },
+                      {"bad_scenario.json: supervision.margin_m: value 1e+09 m is outside [0, 1000]"});
+  ExpectScenarioError([](auto& j) { j["handover_secure_ahead_m"] = 1e300; },
+                      {"bad_scenario.json: handover_secure_ahead_m: value 1e+300 m is outside [0, 1e+07]"});
+  ExpectScenarioError([](auto& j) { j["trains"][0]["resistance"] = {{"a0", 1.5}, {"a1", 0.02}, {"a2", 1e300}}; },
+                      {"bad_scenario.json: trains[0].resistance.a2: value 1e+300 N/kN per (km/h)^2 is outside [0, 1]"});
+  ExpectScenarioError([](auto& j) { j["faults"] = {{{"type", "possession"}, {"begin_m", 100}, {"end_m", 1e300}, {"from_s", 1}, {"to_s", 2}}}; },
+                      {"bad_scenario.json: faults[0].end_m: value 1e+300 m is outside [0, 1e+07]"});
+  ExpectScenarioError([](auto& j) { j["trains"][0]["depart_s"] = 1e300; },
+                      {"bad_scenario.json: trains[0].depart_s: value 1e+300 s is outside [0, 604800]"});
+  ExpectScenarioError([](auto& j) { j["trains"][0]["depart_s"] = 60; },
+                      {"bad_scenario.json: trains[0].depart_s: the train departs at 60 s, at or after the end of the "
+                       "scenario (duration_s 60)"});
+  ExpectScenarioError([](auto& j) { j["trains"][0]["repeat"] = {{"count", 3}, {"interval_s", 35}}; },
+                      {"bad_scenario.json: trains[0].repeat.interval_s: copy 2 departs at 70 s, at or after the end of "
+                       "the scenario (duration_s 60)"});
+  ExpectScenarioError([](auto& j) { j["faults"] = {{{"type", "radio_loss"}, {"train", 2}, {"from_s", 61}, {"to_s", 70}}}; },
+                      {"bad_scenario.json: faults[0].from_s: the fault begins at 61 s, at or after the end of the "
+                       "scenario (duration_s 60)"});
+  ExpectScenarioError([](auto& j) { j["duration_s"] = 1e-6; },
+                      {"bad_scenario.json: duration_s: the scenario is shorter than one step (step_ms 100)"});
+  testing::ExpectInputError([] { (void)ParseScenario(R"({"schema": "railproof/scenario/1", "trains": [{"id": 2, "id": 3}]})", "s.json"); },
+                            "s.json", {"s.json: trains[0]: duplicate key 'id'"});
 }
 
 TEST(SimScenarioFile, EveryProvidedScenarioParses) {

@@ -3,11 +3,10 @@
 // the runtime ground and on-board code, the radio telegram layer over a lossy channel and
 // injected faults; checks the safety invariants at every step. See spec/scenarios/README.md.
 //
-// Exit status: 0 no invariant violated; 1 invariant violations; 2 bad input or error.
+// Exit status: 0 no invariant violated; 1 invariant violations; 2 bad usage or bad input
+// (cli.hpp).
 #include <chrono>
 #include <cstdio>
-#include <filesystem>
-#include <fstream>
 #include <functional>
 #include <iostream>
 #include <string>
@@ -56,9 +55,9 @@ Options ParseArgs(int argc, char** argv) {
                "Simulates a moving-block line scenario: trains with simple longitudinal dynamics, the\n"
                "ground (tracking, interlocking, stop limits) and on-board authority handling, position\n"
                "reports and stop-limit telegrams through the radio telegram layer over a lossy, delaying\n"
-               "channel, and injected faults. Safety invariants are checked after every step.",
-               "Progress: one line per 10 % of simulated time on stderr. Exit status: 0 no invariant\n"
-               "violated, 1 invariant violations, 2 bad input or error.");
+               "channel, and injected faults. Safety invariants are checked after every step.\n"
+               "Progress: one line per 10 % of simulated time on stderr.",
+               "0 no invariant violated, 1 invariant violations");
   const CLI::Validator speed = off::InRange(0.0, 400.0, true);
   cli.Add("--scenario", o.scenario, "scenario (format: spec/scenarios/README.md)")->required();
   cli.Add("--lines-dir", o.lines_dir, "directory of generated line JSON files (<line>.json)")->required();
@@ -106,6 +105,12 @@ int Main(int argc, char** argv) {
   const auto base = railproof::sim::LoadScenario(o.scenario);
   const auto line = railproof::offline::LoadLine(railproof::offline::LinePath(o.lines_dir, base.line));
   const railproof::offline::Progress progress("line_sim", o.quiet);
+  railproof::offline::OutputFiles out;
+  for (const std::string& path : {o.summary, o.svg}) {
+    if (!path.empty()) {
+      out.Reserve(path);
+    }
+  }
 
   if (!o.sweep.empty()) {
     Json runs = Json::array();
@@ -130,17 +135,18 @@ int Main(int argc, char** argv) {
       runs.push_back(Json{{"leader_cap_kmh", cap}, {"result", s["result"]}, {"violations", s["violations"]},
                           {"gap", s["gap"]}});
     }
-    Json out{{"schema", "railproof/sim-sweep/1"},
-             {"scenario", base.name},
-             {"line", base.line},
-             {"requirements", {"REQ-MB-006", "REQ-MB-008", "REQ-MB-018"}},
-             {"runs", runs},
-             {"gap_grows_with_speed", grows},
-             {"result", all_pass ? "PASS" : "FAIL"}};
+    Json sweep{{"schema", "railproof/sim-sweep/1"},
+               {"scenario", base.name},
+               {"line", base.line},
+               {"requirements", {"REQ-MB-006", "REQ-MB-008", "REQ-MB-018"}},
+               {"runs", runs},
+               {"gap_grows_with_speed", grows},
+               {"result", all_pass ? "PASS" : "FAIL"}};
     std::printf("gap grows with the leader's speed: %s\n", grows ? "yes" : "no");
     if (!o.summary.empty()) {
-      railproof::offline::WriteJsonFile(o.summary, out);
+      out.WriteJson(o.summary, sweep);
     }
+    out.Commit();
     return all_pass ? 0 : 1;
   }
 
@@ -149,36 +155,23 @@ int Main(int argc, char** argv) {
     SetLeaderCap(sc, o.leader_cap_kmh);
   }
   railproof::sim::Simulation sim(sc, line);
-  std::ofstream log;
-  std::string log_tmp;
   railproof::sim::RunOptions ro;
   ro.progress = std::cref(progress);
   ro.log_full = o.log_full;
   if (!o.log.empty()) {
-    log_tmp = o.log + ".tmp";
-    log.open(log_tmp, std::ios::binary);
-    if (!log) {
-      throw InputError(o.log + ": cannot write");
-    }
-    ro.log = &log;
+    ro.log = &out.Stream(o.log);
   }
   const auto t0 = std::chrono::steady_clock::now();
   sim.Run(ro);
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  if (!o.log.empty()) {
-    log.close();
-    if (!log) {
-      throw InputError(o.log + ": write failed");
-    }
-    std::filesystem::rename(log_tmp, o.log);
-  }
   const Json s = sim.Summary();
   if (!o.summary.empty()) {
-    railproof::offline::WriteJsonFile(o.summary, s);
+    out.WriteJson(o.summary, s);
   }
   if (!o.svg.empty()) {
-    railproof::offline::WriteFileAtomic(o.svg, sim.Svg());
+    out.Write(o.svg, sim.Svg());
   }
+  out.Commit();
   PrintResult(s, wall);
   return s["result"] == "PASS" ? 0 : 1;
 }

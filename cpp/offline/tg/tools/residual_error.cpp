@@ -3,7 +3,7 @@
 // pipeline). Defaults come from the generated parameters (spec/parameters/tg.yaml).
 #include <cmath>
 #include <cstdio>
-#include <filesystem>
+#include <stdexcept>
 #include <iostream>
 #include <string>
 #include <vector>
@@ -45,23 +45,24 @@ std::string Description() {
   return text;
 }
 
-}  // namespace
-
-// @implements REQ-TG-019
-int main(int argc, char** argv) {
+struct Options {
   ResidualConfig config{};
+  std::vector<double> bers;
+  std::string json;
+};
+
+Options ParseArgs(int argc, char** argv) {
+  namespace off = railproof::offline;
+  Options o;
+  ResidualConfig& config = o.config;
   config.code = {static_cast<unsigned>(tg::rs_n), static_cast<unsigned>(tg::rs_k), DefaultM()};
   config.blocks = DefaultBlocks();
   config.bit_rate_bps = static_cast<double>(tg::radio_bit_rate_bps);
   config.target_per_hour = static_cast<double>(tg::residual_target_per_h);
   config.crc_pass = std::ldexp(1.0L, -16);
-  std::vector<double> bers;
-  std::string json_path;
   double tag_pass = std::ldexp(1.0, -128);
-
-  namespace off = railproof::offline;
-  off::Cli cli("residual_error", Description(), "Prints a table. Exit status: 0 done, 2 bad usage or input.");
-  cli.Add("--ber", bers, "bit error probability in [0, 1]; repeatable")->check(off::InRange(0.0, 1.0));
+  off::Cli cli("residual_error", Description() + "\nPrints a table.", "0 done");
+  cli.Add("--ber", o.bers, "bit error probability in [0, 1]; repeatable")->check(off::InRange(0.0, 1.0));
   cli.Add("--bit-rate", config.bit_rate_bps, "channel bit rate (bit/s)")->check(off::Above(0.0));
   cli.Add("--n", config.code.n, "code length (symbols)");
   cli.Add("--k", config.code.k, "code dimension (symbols)");
@@ -69,28 +70,45 @@ int main(int argc, char** argv) {
   cli.Add("--blocks", config.blocks, "RS blocks per frame (default: the longest frame)")->check(off::InRange(1, 1e9));
   cli.Add("--target", config.target_per_hour, "residual target per hour")->check(off::Above(0.0));
   cli.Add("--tag-pass", tag_pass, "probability that a wrong frame passes the tag")->check(off::InRange(0.0, 1.0));
-  cli.Add("--json", json_path, "also write the results as JSON");
+  cli.Add("--json", o.json, "also write the results as JSON");
   cli.ParseOrExit(argc, argv);
-  config.tag_pass = static_cast<long double>(tag_pass);
-  if (bers.empty()) {  // the two bit error rates D5 reports (spec/parameters)
-    bers.push_back(static_cast<double>(tg::design_ber));
-    bers.push_back(static_cast<double>(tg::comparison_ber));
-  }
-  return off::RunTool("residual_error", [&] {
+  try {
     railproof::tg::analysis::ValidateCode(config.code);
-    std::vector<ResidualResult> results;
-    for (const double b : bers) {
-      results.push_back(railproof::tg::analysis::ComputeResidual(config, b));
-    }
-    std::cout << railproof::tg::analysis::ResidualReportTable(config, results);
-    if (!json_path.empty()) {
-      const std::filesystem::path path(json_path);
-      if (path.has_parent_path()) {
-        std::filesystem::create_directories(path.parent_path());
-      }
-      off::WriteFileAtomic(path, railproof::tg::analysis::ResidualReportJson(config, results));
-      std::cout << "wrote " << json_path << "\n";
-    }
-    return 0;
-  });
+  } catch (const std::invalid_argument& e) {
+    cli.Fail(std::string("--n, --k, --m: ") + e.what());
+  }
+  config.tag_pass = static_cast<long double>(tag_pass);
+  if (o.bers.empty()) {  // the two bit error rates D5 reports (spec/parameters)
+    o.bers.push_back(static_cast<double>(tg::design_ber));
+    o.bers.push_back(static_cast<double>(tg::comparison_ber));
+  }
+  return o;
+}
+
+int Main(int argc, char** argv) {
+  const Options o = ParseArgs(argc, argv);
+  railproof::offline::OutputFiles out;
+  if (!o.json.empty()) {
+    out.Reserve(o.json);
+  }
+  std::vector<ResidualResult> results;
+  for (const double b : o.bers) {
+    results.push_back(railproof::tg::analysis::ComputeResidual(o.config, b));
+  }
+  std::cout << railproof::tg::analysis::ResidualReportTable(o.config, results);
+  if (!o.json.empty()) {
+    out.Write(o.json, railproof::tg::analysis::ResidualReportJson(o.config, results));
+  }
+  out.Commit();
+  if (!o.json.empty()) {
+    std::cout << "wrote " << o.json << "\n";
+  }
+  return 0;
+}
+
+}  // namespace
+
+// @implements REQ-TG-019
+int main(int argc, char** argv) {
+  return railproof::offline::RunTool("residual_error", [&] { return Main(argc, argv); });
 }

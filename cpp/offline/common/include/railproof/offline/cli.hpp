@@ -6,8 +6,11 @@
 //     unknown or unexpected argument is reported before a missing required option;
 //   - a repeatable option (std::vector target) takes one value per occurrence, kept in
 //     order; a number must be the whole text and, if floating-point, finite;
-//   - RunTool() is the tool's main(): bad input (InputError) prints "<tool>: <reason>", any
-//     other exception "<tool>: error: <reason>", both exit 2.
+//   - RunTool() is the tool's main(): bad input (InputError: an input file, or an output that
+//     cannot be written, output_file.hpp) prints "<tool>: <reason>", any other exception
+//     "<tool>: error: <reason>", both exit 2;
+//   - the footer of --help states the exit statuses in one form: the tool's own, then the
+//     2 of bad usage and bad input that every tool shares.
 // The conformance runners use CLI11 the same way (railproof/testing/runner_cli.hpp).
 // Why a library: one well-kept parser for every tool and runner instead of three hand-written
 // ones, and the help is generated from the same table that parses, so a usage text cannot
@@ -35,6 +38,10 @@ struct CliResult {
 
 // Exit status of bad usage and bad input of every tool.
 inline constexpr int kUsageExit = 2;
+// What the footer of every tool's --help says of it.
+inline constexpr const char* kBadUsageStatus =
+    "2 bad usage or bad input: an input file, or an output that cannot be written\n"
+    "(one line \"<tool>: <file>: <reason>\" on stderr; no result file is changed).";
 
 namespace cli_detail {
 // The checks Cli::Add attaches to a number option: the whole text is a finite number, or a
@@ -60,8 +67,10 @@ CLI::Option* Repeatable(CLI::Option* option, bool empty);
 class Cli {
  public:
   // `tool` is the program name in the usage line and the prefix of every message;
-  // `description` opens --help, `footer` follows the options (the exit status).
-  Cli(std::string tool, const std::string& description, const std::string& footer = "");
+  // `description` opens --help; `exit_statuses`, the tool's own exit statuses ("0 pass, 1 a
+  // check failed (named on stderr)"), begin the footer, which ends with the status 2 shared by
+  // every tool (kBadUsageStatus).
+  Cli(std::string tool, const std::string& description, const std::string& exit_statuses = "0 done");
   Cli(const Cli&) = delete;
   Cli& operator=(const Cli&) = delete;
 

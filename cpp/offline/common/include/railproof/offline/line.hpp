@@ -19,10 +19,16 @@
 
 namespace railproof::offline {
 
-// Any bad input of the simulation (line JSON, scenario file): one line, names file and entry.
+// `text` as one line of UTF-8 text: every control character (a newline or a tab in a key, an
+// identifier or a file name of the input) is written as an escape ("\n", "\t", "\x01"), and
+// every byte that is not UTF-8 as U+FFFD.
+std::string OneLine(std::string_view text);
+
+// Any bad input of an offline tool (a data file, an output path): one line "<file>: <entry>:
+// <reason>" (or "<file>: <reason>"), which OneLine makes of whatever text it is given.
 class InputError : public std::runtime_error {
  public:
-  using std::runtime_error::runtime_error;
+  explicit InputError(std::string_view what) : std::runtime_error(OneLine(what)) {}
 };
 
 inline constexpr std::string_view kLineSchema = "railproof/line-json/1";
