@@ -899,7 +899,9 @@ TEST(OdometryStartUp, MovingOffDuringTheWarmUpIsAStartInMotion) {
         k == 50 ? std::optional<std::int64_t>(std::llround(s.TrueFrontMm())) : std::nullopt;
     const OdometryOutput& o = od->Step(s.Next({0.5, 0.0}, m, balise));
     EXPECT_FALSE(o.position_valid) << k;
-    if (k > 4) EXPECT_EQ(o.stop_reason, StopReason::kStartInMotion) << k;
+    if (k > 4) {
+      EXPECT_EQ(o.stop_reason, StopReason::kStartInMotion) << k;
+    }
   }
 }
 

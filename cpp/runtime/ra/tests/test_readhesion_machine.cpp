@@ -575,7 +575,9 @@ TEST(OdometryReadhesionMachine, DeviationRunWhileWaitingWithdrawsTheTrust) {
   ASSERT_TRUE(m.state().trusted);
   for (int k = 1; k < m.config().confirm_cycles; ++k) Cycle(m, In(true));
   EXPECT_TRUE(Cycle(m, In(false)).trusted);  // confirm_cycles - 1, then none: kept
-  for (int k = 1; k < m.config().confirm_cycles; ++k) EXPECT_TRUE(Cycle(m, In(true)).trusted);
+  for (int k = 1; k < m.config().confirm_cycles; ++k) {
+    EXPECT_TRUE(Cycle(m, In(true)).trusted);
+  }
   const MachineState& s = Cycle(m, In(true));
   ExpectStopped(s, StopReason::kMaxCompensationTime);
   EXPECT_FALSE(s.trusted);
