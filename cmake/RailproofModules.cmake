@@ -289,7 +289,9 @@ endfunction()
 #   data.md §2): SOURCES are the target's file and the loader's sources, compiled into one
 #   executable with the shared harness (cpp/offline/common/fuzz/json_fuzz.hpp); INCLUDES the
 #   include folders of those sources (the offline modules are not linked: their loaders are the
-#   instrumented sources), LINKS the runtime modules and libraries it needs (uninstrumented);
+#   instrumented sources; the loaders of offline/common that several targets read, the JSON
+#   reader, the line and the train type, come instrumented once from fuzz_loaders, see
+#   railproof_fuzz_library), LINKS the runtime modules and libraries it needs (uninstrumented);
 #   DEPENDS the targets that make its data. Its seeds are the committed corpus fuzz/corpus/<name without fuzz_>/ of the calling
 #   folder and the SEEDS folders (read only: the data the loader is made for).
 #   With RAILPROOF_FUZZ (clang): a libFuzzer executable with coverage and ASan+UBSan, and the
@@ -302,6 +304,21 @@ endfunction()
 #   ORACLE_FIRES makes a negative test of the oracle instead (libFuzzer builds): for each
 #   committed seed named, the entry <name>_<seed without .json> passes when the oracle fires on
 #   it with the message "railproof-fuzz: oracle violated: <message>" (a regular expression).
+# railproof_fuzz_library(<name> SOURCES ... LINKS ...): a static library railproof_<name> of
+#   loader sources several fuzz targets share, compiled once with the fuzz targets' flags (with
+#   RAILPROOF_FUZZ: coverage instrumentation without libFuzzer's main, ASan+UBSan; otherwise
+#   the build's flags), instead of once per target.
+function(railproof_fuzz_library name)
+  cmake_parse_arguments(A "" "" "SOURCES;LINKS" ${ARGN})
+  _railproof_resolve(links ${A_LINKS})
+  _railproof_static_library(railproof_${name} railproof_options SOURCES ${A_SOURCES} LINKS ${links})
+  if(RAILPROOF_FUZZ)
+    target_compile_options(railproof_${name} PRIVATE -fsanitize=fuzzer-no-link,address,undefined
+                           -fno-sanitize-recover=all -fno-omit-frame-pointer -g -O1)
+  endif()
+  _railproof_record(railproof_${name} "offline" ${links})
+endfunction()
+
 function(railproof_input_fuzz_target name)
   cmake_parse_arguments(A "" "SECONDS;CAPABILITY" "SOURCES;INCLUDES;LINKS;SEEDS;DEFINITIONS;DEPENDS;ORACLE_FIRES" ${ARGN})
   if(NOT A_SECONDS)
