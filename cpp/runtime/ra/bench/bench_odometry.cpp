@@ -2,7 +2,9 @@
 // core): Odometry::Step in TG odometry, in a compensating cycle with both parallel start
 // points active, and on the detection cycle with the deepest catch-up (start point at the
 // oldest allowed point d - 75, the second at d - 100: 175 candidate cycles integrated from
-// the history). Synthetic 12 m/s stream, level line, 90-tooth TG, 10 IMU samples a cycle.
+// the history). Synthetic 12 m/s stream, level line, 90-tooth TG, 10 IMU samples a cycle;
+// each stream begins with the start-up the odometry needs (REQ-RA-015: a warm-up at
+// standstill, a run-up to 12 m/s, the averages settling), which is never timed.
 // The compensating and detection cycles are timed manually around Step (the state is
 // restored from a copy outside the timed region).
 #include <benchmark/benchmark.h>
@@ -24,23 +26,41 @@ using namespace railproof::ra;  // NOLINT(google-build-using-namespace)
 
 constexpr double kPulseM = 3.14159265358979323846 * 0.86 / 90.0;
 
-// Train at constant speed; from cycle `slip_from` the wheel slips with a slip speed rising
-// 0.3 m/s per cycle to 3 m/s and staying there (no re-adhesion). With `noisy_jerk` the IMU
-// a_x alternates +1, +1, -1, -1 m/s^2 so the jerk conditions fail in every cycle (the
-// start-point search falls back to the oldest point).
+// The warm-up at standstill the odometry needs after its start before it trusts its TG
+// history (REQ-RA-015): the moving averages plus the TG window.
+constexpr int kWarmupCycles =
+    static_cast<int>((railproof::params::ra::moving_average_ms + railproof::params::ra::tg_window_ms) /
+                     railproof::params::ra::cycle_ms);
+constexpr double kSpeed = 12.0;   // m/s
+constexpr double kAccel = 1.0;    // m/s^2 of the run-up
+constexpr int kRunUpCycles = 120;  // 12 m/s at 1 m/s^2
+// Cycles before the constant-speed part: the warm-up, the run-up and the warm-up again at
+// 12 m/s (the averages and the TG window hold the constant speed only).
+constexpr int kPrefixCycles = kWarmupCycles + kRunUpCycles + kWarmupCycles;
+
+// A fresh start: the train stands for the warm-up, runs up to 12 m/s (the IMU measuring it)
+// and runs at 12 m/s; `cycles` counts the cycles after the prefix. From cycle `slip_from`
+// of them the wheel slips with a slip speed rising 0.3 m/s per cycle to 3 m/s and staying
+// there (no re-adhesion). With `noisy_jerk` the IMU a_x alternates +1, +1, -1, -1 m/s^2 at
+// constant speed so the jerk conditions fail in every cycle (the start-point search falls
+// back to the oldest point).
 std::vector<CycleInput> MakeStream(int cycles, int slip_from, bool noisy_jerk) {
   std::vector<CycleInput> out;
-  out.reserve(static_cast<std::size_t>(cycles));
-  const double v = 12.0;
+  out.reserve(static_cast<std::size_t>(kPrefixCycles + cycles));
+  double v = 0;
   double xw = 0, slip = 0;  // wheel distance and slip speed
   std::int64_t pulses = 0, edge = 0, t_ms = 1'000;
-  for (int k = 0; k < cycles; ++k) {
+  for (int n = 0; n < kPrefixCycles + cycles; ++n) {
+    const int k = n - kPrefixCycles;  // cycle of the constant-speed part (< 0 before it)
+    const bool running_up = n >= kWarmupCycles && n < kWarmupCycles + kRunUpCycles;
+    const double v_end = running_up ? std::min(kSpeed, v + kAccel * 0.1) : v;
     t_ms += 100;
     const double slip_end = k < slip_from ? 0.0 : std::min(3.0, 0.3 * (k - slip_from + 1));
     for (int ms = 1; ms <= 100; ++ms) {
       const double s1 = slip + (slip_end - slip) * ms / 100.0;
+      const double v1 = v + (v_end - v) * ms / 100.0;
       const double xw0 = xw;
-      xw += (v + s1) * 0.001;
+      xw += (v1 + s1) * 0.001;
       while (std::floor(xw / kPulseM) > static_cast<double>(pulses)) {
         ++pulses;
         const double frac = (static_cast<double>(pulses) * kPulseM - xw0) / (xw - xw0);
@@ -48,6 +68,7 @@ std::vector<CycleInput> MakeStream(int cycles, int slip_from, bool noisy_jerk) {
       }
     }
     slip = slip_end;
+    v = v_end;
     CycleInput in;
     in.time_ms = t_ms;
     in.tg.time_us = t_ms * 1000;
@@ -56,7 +77,13 @@ std::vector<CycleInput> MakeStream(int cycles, int slip_from, bool noisy_jerk) {
     for (int j = 0; j < 10; ++j) {
       auto& s = in.imu[static_cast<std::size_t>(j)];
       s.time_us = t_ms * 1000 - (9 - j) * 10'000;
-      s.ax = noisy_jerk ? ((k % 4 < 2) ? 1.0 : -1.0) : 0.01 * std::sin(0.3 * j + k);
+      if (running_up) {
+        s.ax = kAccel;
+      } else if (k < 0) {
+        s.ax = 0.0;
+      } else {
+        s.ax = noisy_jerk ? ((k % 4 < 2) ? 1.0 : -1.0) : 0.01 * std::sin(0.3 * j + k);
+      }
       s.ay = 0.02;
       s.az = 9.807;
       s.wx = 0.001;
@@ -117,16 +144,30 @@ const OdometryOutput& TimedStep(benchmark::State& state, Odometry& od, const Cyc
   return o;
 }
 
-// TG odometry: every cycle of a 4096-cycle stream without slip (re-created at its end).
+// The odometry after the start-up prefix of a stream (warm-up, run-up, settling).
+std::unique_ptr<Odometry> AfterPrefix(const std::vector<CycleInput>& stream) {
+  auto od = Make();
+  for (std::size_t k = 0; k < static_cast<std::size_t>(kPrefixCycles); ++k) {
+    od->Step(stream[k]);
+  }
+  return od;
+}
+
+// TG odometry: every constant-speed cycle of a stream of 4096 of them without slip (the
+// odometry re-created after the start-up prefix at the stream's end, untimed).
 void BM_OdometryStepTg(benchmark::State& state) {
   const auto stream = MakeStream(4'096, 1'000'000, false);
-  auto od = Make();
-  std::size_t i = 0;
+  auto od = AfterPrefix(stream);
+  if (od->output().mode != Mode::kTg || !od->output().position_valid) {
+    state.SkipWithError("not in TG odometry after the start-up");
+    return;
+  }
+  std::size_t i = kPrefixCycles;
   for (auto _ : state) {
     if (i == stream.size()) {
       state.PauseTiming();
-      od = Make();
-      i = 0;
+      od = AfterPrefix(stream);
+      i = kPrefixCycles;
       state.ResumeTiming();
     }
     benchmark::DoNotOptimize(od->Step(stream[i]));
