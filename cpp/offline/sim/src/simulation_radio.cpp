@@ -7,13 +7,31 @@
 #include <map>
 #include <optional>
 #include <span>
+#include <stdexcept>
 #include <string>
+#include <variant>
 #include <vector>
 
-#include "railproof/sim/codec.hpp"
+#include "railproof/messages/codec.hpp"
 #include "railproof/tg/frame.hpp"
 
 namespace railproof::sim {
+
+namespace {
+
+// The payload of a message the simulation built; a message the codec refuses is a fault of
+// the simulation (its trains and ground give values inside the codec's ranges).
+messages::Payload EncodeOrThrow(const messages::Message& m) {
+  const messages::Encoded e = messages::Encode(m);
+  if (!e.Ok()) {
+    throw std::logic_error(std::string("line simulation: a ") + messages::ToString(messages::TypeOf(m)) +
+                           " message is not encodable: " + messages::ToString(e.error) + " " +
+                           messages::ToString(e.invalid) + " " + messages::ToString(e.field));
+  }
+  return e.payload;
+}
+
+}  // namespace
 
 void Simulation::Impl::DeliverFrames() {
   std::array<std::uint8_t, tg::kPayloadMax> buffer{};
@@ -53,17 +71,13 @@ std::optional<std::span<const std::uint8_t>> Simulation::Impl::Accept(tg::Endpoi
 }
 
 void Simulation::Impl::OnPositionReport(TrainRt& t, const Frame& f, std::span<const std::uint8_t> payload) {
-  bool malformed = false;
-  const auto rep = DecodePosition(payload, malformed);
-  if (malformed) {
-    ++up.malformed;
-    return;
-  }
-  if (!rep) {
+  const messages::Decoded decoded = messages::Decode(payload);
+  if (std::holds_alternative<messages::NoPosition>(decoded.message)) {
     return;  // no position (tracking loss on board): nothing for the ground
   }
-  if (rep->train_id != t.spec.id) {
-    ++up.malformed;
+  const auto* rep = std::get_if<messages::PositionReport>(&decoded.message);
+  if (rep == nullptr || rep->train_id != t.spec.id) {
+    ++up.malformed;  // not a message, another type, or another train's
     return;
   }
   const auto st = ground->OnReport(*rep);
@@ -80,14 +94,14 @@ void Simulation::Impl::OnPositionReport(TrainRt& t, const Frame& f, std::span<co
 }
 
 void Simulation::Impl::OnStopLimit(TrainRt& t, std::span<const std::uint8_t> payload) {
-  bool malformed = false;
-  const auto tg = DecodeStopLimit(payload, malformed);
-  if (malformed || (tg && tg->train_id != t.spec.id)) {
-    ++down.malformed;
-    return;
-  }
-  if (!tg) {
+  const messages::Decoded decoded = messages::Decode(payload);
+  if (std::holds_alternative<messages::KeepAlive>(decoded.message)) {
     return;  // keep-alive: no limit for this train
+  }
+  const auto* tg = std::get_if<messages::StopLimitTelegram>(&decoded.message);
+  if (tg == nullptr || tg->train_id != t.spec.id) {
+    ++down.malformed;  // not a message, another type, or another train's
+    return;
   }
   const auto before = t.auth.Limit();
   const auto v = t.auth.Receive(tg->limit_mm, tg->issue_time_ms, now);
@@ -215,18 +229,18 @@ void Simulation::Impl::GroundCycle() {
     Json c{{"train", t->spec.id}, {"limit_mm", o->limit_mm ? Json(*o->limit_mm) : Json(nullptr)},
            {"kind", messages::ToString(o->kind)}, {"abnormal", o->abnormal}};
     cyc.push_back(c);
-    std::vector<std::uint8_t> payload;
+    messages::Payload payload;
     const auto it = tgs.find(t->spec.id);
     if (it != tgs.end()) {
-      payload = EncodeStopLimit(*it->second);
+      payload = EncodeOrThrow(*it->second);
       ++telegrams_issued;
       exercised.insert("REQ-MB-024");
       exercised.insert("REQ-MB-006");
     } else {
-      payload = EncodeKeepAlive();
+      payload = EncodeOrThrow(messages::KeepAlive{});
     }
     tg::EncodedFrame frame{};
-    const auto out = t->ground_ep.Cycle(Clock32(now), payload, frame);
+    const auto out = t->ground_ep.Cycle(Clock32(now), payload.View(), frame);
     if (out.status == tg::SendStatus::kSent) {
       channel.Send(t->spec.id, Direction::kDownlink, now, frame.View(), t->radio_blocked);
     }
@@ -240,9 +254,9 @@ void Simulation::Impl::SendReports() {
       continue;
     }
     t->next_report_ms += sc.report_period_ms;
-    std::vector<std::uint8_t> payload;
+    messages::Payload payload;
     if (t->position_lost) {
-      payload = EncodeNoPosition();
+      payload = EncodeOrThrow(messages::NoPosition{});
     } else {
       const std::int64_t front = std::clamp<std::int64_t>(ToMm(t->est_front_m), 0, rl->length_mm);
       const auto [block, offset] = Locate(front);
@@ -255,14 +269,14 @@ void Simulation::Impl::SendReports() {
       rep.last_balise_mm = t->last_balise_mm;
       rep.speed_mm_s = static_cast<std::int64_t>(std::llround(t->motion.speed * 1000.0));
       rep.direction = mb::wayside::Direction::kNominal;
-      payload = EncodePosition(rep);
+      payload = EncodeOrThrow(rep);
       ++t->reports_sent;
       exercised.insert("REQ-MB-001");
       exercised.insert("REQ-MB-002");
       exercised.insert("REQ-MB-003");
     }
     tg::EncodedFrame frame{};
-    const auto out = t->train_ep.Cycle(Clock32(now), payload, frame);
+    const auto out = t->train_ep.Cycle(Clock32(now), payload.View(), frame);
     t->link_up = out.link == tg::LinkState::kUp;
     if (out.status == tg::SendStatus::kSent) {
       channel.Send(t->spec.id, Direction::kUplink, now, frame.View(), t->radio_blocked);

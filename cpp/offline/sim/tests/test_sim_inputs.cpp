@@ -1,5 +1,5 @@
 // Unit tests of the simulation's inputs: line JSON loader (REQ-MB-020), ground line
-// building, scenario files, payload codec.
+// building, scenario files (the payload coding is the runtime codec's, cpp/runtime/messages/tests).
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -10,7 +10,6 @@
 
 #include <nlohmann/json.hpp>
 
-#include "railproof/sim/codec.hpp"
 #include "railproof/sim/ground_line.hpp"
 #include "railproof/offline/line.hpp"
 #include "railproof/sim/scenario.hpp"
@@ -279,54 +278,6 @@ TEST(SimScenarioFile, EveryProvidedScenarioParses) {
     }) << entry.path();
   }
   EXPECT_GE(n, 7U);
-}
-
-// ---- payload codec ---------------------------------------------------------------------
-
-TEST(SimCodec, PositionAndStopLimitPayloadsRoundTrip) {
-  const messages::PositionReport r{.train_id = 7,
-                                   .front_block = 12,
-                                   .offset_mm = 34'567,
-                                   .length_mm = 100'000,
-                                   .correction_mm = 321,
-                                   .last_balise_mm = 250'000,
-                                   .speed_mm_s = 27'777,
-                                   .direction = mb::wayside::Direction::kNominal};
-  bool malformed = true;
-  const auto back = DecodePosition(EncodePosition(r), malformed);
-  ASSERT_TRUE(back.has_value());
-  EXPECT_FALSE(malformed);
-  EXPECT_EQ(back->offset_mm, 34'567);
-  EXPECT_EQ(back->speed_mm_s, 27'777);
-  EXPECT_EQ(back->front_block, 12U);
-  EXPECT_FALSE(DecodePosition(EncodeNoPosition(), malformed).has_value());
-  EXPECT_FALSE(malformed);
-  auto bytes = EncodePosition(r);
-  bytes.pop_back();
-  EXPECT_FALSE(DecodePosition(bytes, malformed).has_value());
-  EXPECT_TRUE(malformed);
-
-  messages::StopLimitTelegram t{};
-  t.train_id = 7;
-  t.limit_mm = 1'234'567;
-  t.kind = messages::Obstruction::kPossession;
-  t.issue_time_ms = 99'500;
-  t.restriction_count = 1;
-  t.restrictions[0] = messages::SpeedRestriction{3, 2'000'000, 2'500'000, 8'333};
-  const auto tb = DecodeStopLimit(EncodeStopLimit(t), malformed);
-  ASSERT_TRUE(tb.has_value());
-  EXPECT_EQ(tb->limit_mm, 1'234'567);
-  EXPECT_EQ(tb->kind, messages::Obstruction::kPossession);
-  EXPECT_EQ(tb->issue_time_ms, 99'500);
-  ASSERT_EQ(tb->restriction_count, 1U);
-  EXPECT_EQ(tb->restrictions[0].end_mm, 2'500'000);
-  EXPECT_EQ(tb->restrictions[0].speed_mm_s, 8'333);
-  EXPECT_FALSE(DecodeStopLimit(EncodeKeepAlive(), malformed).has_value());
-  EXPECT_FALSE(malformed);
-  auto tbytes = EncodeStopLimit(t);
-  tbytes.push_back(0);
-  EXPECT_FALSE(DecodeStopLimit(tbytes, malformed).has_value());
-  EXPECT_TRUE(malformed);
 }
 
 }  // namespace
