@@ -547,6 +547,33 @@ TEST(MessagesCodec, EveryTruncationIsRejected) {
   EXPECT_GT(cuts, 400U);
 }
 
+// Nothing beyond the end of a payload is read: a cut that ends before the entry count of a
+// list message is rejected for its length, whatever byte lies beyond the cut (here a count
+// above the maximum, which a read past the end would report as kTooManyEntries).
+// @verifies REQ-MB-024 REQ-LC-003
+TEST(MessagesCodec, NoByteBeyondTheCutIsRead) {
+  struct ListMessage {
+    const char* name;
+    Bytes whole;
+    std::size_t count_at;  // offset of the entry count (codec.hpp layouts)
+  };
+  const std::array<ListMessage, 2> lists{{
+      {"stop limit", ToBytes(Encode(test::StopLimitMax()).payload), 22},
+      {"crossing report", ToBytes(Encode(test::ReportMax()).payload), 23},
+  }};
+  for (const ListMessage& m : lists) {
+    SCOPED_TRACE(m.name);
+    ASSERT_GT(m.whole.size(), m.count_at);
+    Bytes beyond = m.whole;
+    beyond[m.count_at] = 0xFF;
+    for (std::size_t len = 1; len <= m.count_at; ++len) {
+      EXPECT_EQ(Decode(std::span<const std::uint8_t>(beyond).first(len)).error, DecodeError::kWrongLength)
+          << "length " << len;
+    }
+    EXPECT_EQ(Decode(beyond).error, DecodeError::kTooManyEntries);  // the count read where it is
+  }
+}
+
 // A corrupted type byte never yields a message of the sent type: a value outside 1..9 is
 // kUnknownType; another type is decoded only if the length is that type's (then it is that
 // type's message: request, withdrawal and acknowledgement, no-position and keep-alive, share
