@@ -26,17 +26,20 @@ using namespace railproof::ra;  // NOLINT(google-build-using-namespace)
 
 constexpr double kPulseM = 3.14159265358979323846 * 0.86 / 90.0;
 
-// The warm-up at standstill the odometry needs after its start before it trusts its TG
-// history (REQ-RA-015): the moving averages plus the TG window.
-constexpr int kWarmupCycles =
-    static_cast<int>((railproof::params::ra::moving_average_ms + railproof::params::ra::tg_window_ms) /
-                     railproof::params::ra::cycle_ms);
 constexpr double kSpeed = 12.0;   // m/s
 constexpr double kAccel = 1.0;    // m/s^2 of the run-up
 constexpr int kRunUpCycles = 120;  // 12 m/s at 1 m/s^2
+std::unique_ptr<Odometry> Make();
+
+// The warm-up at standstill the odometry needs after its start before it trusts its TG
+// history (REQ-RA-015), as its re-adhesion machine is configured.
+int WarmupCycles() {
+  static const int cycles = Make()->machine().config().warmup_cycles;
+  return cycles;
+}
 // Cycles before the constant-speed part: the warm-up, the run-up and the warm-up again at
 // 12 m/s (the averages and the TG window hold the constant speed only).
-constexpr int kPrefixCycles = kWarmupCycles + kRunUpCycles + kWarmupCycles;
+int PrefixCycles() { return WarmupCycles() + kRunUpCycles + WarmupCycles(); }
 
 // A fresh start: the train stands for the warm-up, runs up to 12 m/s (the IMU measuring it)
 // and runs at 12 m/s; `cycles` counts the cycles after the prefix. From cycle `slip_from`
@@ -46,13 +49,13 @@ constexpr int kPrefixCycles = kWarmupCycles + kRunUpCycles + kWarmupCycles;
 // back to the oldest point).
 std::vector<CycleInput> MakeStream(int cycles, int slip_from, bool noisy_jerk) {
   std::vector<CycleInput> out;
-  out.reserve(static_cast<std::size_t>(kPrefixCycles + cycles));
+  out.reserve(static_cast<std::size_t>(PrefixCycles() + cycles));
   double v = 0;
   double xw = 0, slip = 0;  // wheel distance and slip speed
   std::int64_t pulses = 0, edge = 0, t_ms = 1'000;
-  for (int n = 0; n < kPrefixCycles + cycles; ++n) {
-    const int k = n - kPrefixCycles;  // cycle of the constant-speed part (< 0 before it)
-    const bool running_up = n >= kWarmupCycles && n < kWarmupCycles + kRunUpCycles;
+  for (int n = 0; n < PrefixCycles() + cycles; ++n) {
+    const int k = n - PrefixCycles();  // cycle of the constant-speed part (< 0 before it)
+    const bool running_up = n >= WarmupCycles() && n < WarmupCycles() + kRunUpCycles;
     const double v_end = running_up ? std::min(kSpeed, v + kAccel * 0.1) : v;
     t_ms += 100;
     const double slip_end = k < slip_from ? 0.0 : std::min(3.0, 0.3 * (k - slip_from + 1));
@@ -147,7 +150,7 @@ const OdometryOutput& TimedStep(benchmark::State& state, Odometry& od, const Cyc
 // The odometry after the start-up prefix of a stream (warm-up, run-up, settling).
 std::unique_ptr<Odometry> AfterPrefix(const std::vector<CycleInput>& stream) {
   auto od = Make();
-  for (std::size_t k = 0; k < static_cast<std::size_t>(kPrefixCycles); ++k) {
+  for (std::size_t k = 0; k < static_cast<std::size_t>(PrefixCycles()); ++k) {
     od->Step(stream[k]);
   }
   return od;
@@ -162,12 +165,12 @@ void BM_OdometryStepTg(benchmark::State& state) {
     state.SkipWithError("not in TG odometry after the start-up");
     return;
   }
-  std::size_t i = kPrefixCycles;
+  std::size_t i = static_cast<std::size_t>(PrefixCycles());
   for (auto _ : state) {
     if (i == stream.size()) {
       state.PauseTiming();
       od = AfterPrefix(stream);
-      i = kPrefixCycles;
+      i = static_cast<std::size_t>(PrefixCycles());
       state.ResumeTiming();
     }
     benchmark::DoNotOptimize(od->Step(stream[i]));
