@@ -4,7 +4,10 @@
 //  - a decoded message is of the type its first byte names, and re-encodes to exactly the
 //    input bytes (the layout is a bijection on valid payloads);
 //  - a rejection is typed: a named DecodeError, no message left behind, and a field exactly
-//    for the field checks (kTooManyEntries .. kUnsorted), a named one.
+//    for the field checks (kTooManyEntries .. kUnsorted), a named one;
+//  - the bundle decoder agrees with Decode on every payload that is not a BUNDLE (a bundle of
+//    one); a decoded BUNDLE holds 2 .. kBundleMax messages and EncodeBundle gives back exactly
+//    the input bytes; a rejected one holds nothing and names its reason.
 // Any violation prints "railproof-fuzz: oracle violated: ..." and traps.
 #include <algorithm>
 #include <cstddef>
@@ -60,6 +63,30 @@ void CheckRejected(const rm::Decoded& d) noexcept {
   }
 }
 
+void CheckBundle(std::span<const std::uint8_t> in, const rm::Decoded& plain) noexcept {
+  const rm::DecodedBundle b = rm::DecodeBundle(in);
+  const bool is_bundle = !in.empty() && in[0] == rm::kBundleType;
+  if (!is_bundle) {
+    if (b.error != plain.error || b.field != plain.field || b.bundle.size != (plain.Ok() ? 1U : 0U)) {
+      OracleViolation("the bundle decoder disagrees with Decode on a plain payload");
+    }
+    return;
+  }
+  if (!b.Ok()) {
+    if (b.bundle.size != 0 || std::strcmp(rm::ToString(b.error), "INVALID") == 0 || b.entry >= rm::kBundleMax) {
+      OracleViolation("bundle rejection holds messages, is unnamed or names no entry");
+    }
+    return;
+  }
+  if (b.bundle.size < 2 || b.bundle.size > rm::kBundleMax) {
+    OracleViolation("decoded bundle outside 2 .. kBundleMax messages");
+  }
+  const rm::Encoded e = rm::EncodeBundle(b.bundle.View());
+  if (!e.Ok() || !SameBytes(e.payload, in)) {
+    OracleViolation("re-encoded bundle differs from the input bytes");
+  }
+}
+
 }  // namespace
 
 // @verifies REQ-MB-001 REQ-MB-024 REQ-LC-003 REQ-LC-010
@@ -78,5 +105,6 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   } else {
     CheckRejected(d);
   }
+  CheckBundle(in, d);
   return 0;
 }

@@ -9,6 +9,7 @@
 // Human-readable lines go to stderr, one JSON summary line to stdout. Test tool (may allocate
 // and throw).
 #include <algorithm>
+#include <array>
 #include <cstdint>
 #include <cstdio>
 #include <exception>
@@ -79,10 +80,36 @@ std::map<std::string, std::pair<Bytes, rm::DecodeError>> BuildCorpus() {
          Patched(t::StopLimitMax(), 32, {0x80, 0, 0, 0}));
   reject("rear-ahead", rm::DecodeError::kEmptyRange, Patched(t::CentreMin(), 28, {0x02}));
   reject("restrictions-swapped", rm::DecodeError::kUnsorted, swapped);
+  // bundles (checked with DecodeBundle below): a position report with a crossing request and a
+  // withdrawal, the same with a bad count, and cut inside its last entry
+  const std::array<rm::Message, 3> uplink = {rm::Message{t::PositionMax()}, rm::Message{rm::CrossingRequest{7, 3}},
+                                             rm::Message{rm::CrossingWithdrawal{{7, 4}}}};
+  const rm::Encoded bundle = rm::EncodeBundle(uplink);
+  const Bytes bundle_bytes(bundle.payload.View().begin(), bundle.payload.View().end());
+  Bytes bad_count = bundle_bytes;
+  bad_count[1] = 1;
+  Bytes oversized = {rm::kBundleType, 3};  // three position reports: more than a telegram carries
+  for (int i = 0; i < 3; ++i) {
+    const Bytes report = Encoded(t::PositionMax());
+    oversized.push_back(static_cast<std::uint8_t>(report.size()));
+    oversized.insert(oversized.end(), report.begin(), report.end());
+  }
+  std::map<std::string, std::pair<Bytes, rm::DecodeError>> bundles;
+  bundles["reject-bundle-WRONG_LENGTH-oversized.bin"] = {oversized, rm::DecodeError::kWrongLength};
+  bundles["valid-bundle-uplink.bin"] = {bundle_bytes, rm::DecodeError::kNone};
+  bundles["reject-bundle-TOO_MANY_ENTRIES-count-1.bin"] = {bad_count, rm::DecodeError::kTooManyEntries};
+  bundles["reject-bundle-WRONG_LENGTH-cut.bin"] = {Bytes(bundle_bytes.begin(), bundle_bytes.end() - 1),
+                                                   rm::DecodeError::kWrongLength};
   for (const auto& [name, seed] : seeds) {  // each seed takes the path its name promises
     if (rm::Decode(seed.first).error != seed.second) {
       throw std::logic_error(name + ": the decoder says " + rm::ToString(rm::Decode(seed.first).error));
     }
+  }
+  for (const auto& [name, seed] : bundles) {
+    if (rm::DecodeBundle(seed.first).error != seed.second) {
+      throw std::logic_error(name + ": the bundle decoder says " + rm::ToString(rm::DecodeBundle(seed.first).error));
+    }
+    seeds[name] = seed;
   }
   return seeds;
 }

@@ -477,4 +477,110 @@ Encoded Encode(const Message& message) noexcept {
   return e;
 }
 
+namespace {
+
+// A bundle's own bytes: the type byte and the count; each entry adds its size byte.
+constexpr std::size_t kBundleHeaderBytes = 2;
+constexpr std::size_t kBundleEntryHeaderBytes = 1;
+static_assert(kBundleMax <= 255 && kPayloadCapacity <= 255, "counts and entry sizes fit one byte");
+
+DecodedBundle BundleFailure(DecodeError e, Field f, std::size_t entry) noexcept {
+  DecodedBundle d;
+  d.error = e;
+  d.field = f;
+  d.entry = entry;
+  return d;
+}
+
+}  // namespace
+
+std::size_t EncodedSize(const Message& m) noexcept { return Encode(m).payload.size; }
+
+std::size_t BundleSize(std::span<const Message> messages) noexcept {
+  if (messages.size() == 1) {
+    return EncodedSize(messages[0]);
+  }
+  std::size_t total = kBundleHeaderBytes;
+  for (const Message& m : messages) {
+    const std::size_t n = EncodedSize(m);
+    if (n == 0) {
+      return 0;
+    }
+    total += kBundleEntryHeaderBytes + n;
+  }
+  return messages.empty() ? 0 : total;
+}
+
+DecodedBundle DecodeBundle(std::span<const std::uint8_t> payload) noexcept {
+  if (payload.empty() || payload[0] != kBundleType) {
+    const Decoded one = Decode(payload);
+    if (!one.Ok()) {
+      return BundleFailure(one.error, one.field, 0);
+    }
+    DecodedBundle d;
+    static_cast<void>(d.bundle.Add(one.message));  // an empty bundle has room
+    return d;
+  }
+  if (payload.size() < kBundleHeaderBytes || payload.size() > kPayloadCapacity) {
+    return BundleFailure(DecodeError::kWrongLength, Field::kNone, 0);  // no telegram carries more
+  }
+  const std::size_t n = payload[1];
+  if (n < 2 || n > kBundleMax) {
+    return BundleFailure(DecodeError::kTooManyEntries, Field::kBundleCount, 0);
+  }
+  DecodedBundle d;
+  std::size_t at = kBundleHeaderBytes;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (at >= payload.size() || payload.size() - at - kBundleEntryHeaderBytes < payload[at]) {
+      return BundleFailure(DecodeError::kWrongLength, Field::kNone, i);
+    }
+    const std::size_t size = payload[at];
+    const Decoded one = Decode(payload.subspan(at + kBundleEntryHeaderBytes, size));
+    if (!one.Ok()) {
+      return BundleFailure(one.error, one.field, i);
+    }
+    static_cast<void>(d.bundle.Add(one.message));  // i < n <= kBundleMax
+    at += kBundleEntryHeaderBytes + size;
+  }
+  if (at != payload.size()) {
+    return BundleFailure(DecodeError::kWrongLength, Field::kNone, n - 1);
+  }
+  return d;
+}
+
+Encoded EncodeBundle(std::span<const Message> messages) noexcept {
+  if (messages.size() == 1) {
+    return Encode(messages[0]);
+  }
+  Encoded out;
+  if (messages.empty()) {
+    out.error = EncodeError::kNoMessage;
+    return out;
+  }
+  if (messages.size() > kBundleMax) {
+    out.error = EncodeError::kTooLarge;
+    return out;
+  }
+  Payload& p = out.payload;
+  p.bytes[0] = kBundleType;
+  p.bytes[1] = static_cast<std::uint8_t>(messages.size());
+  p.size = kBundleHeaderBytes;
+  for (const Message& m : messages) {
+    Encoded one = Encode(m);
+    if (!one.Ok()) {
+      one.payload = Payload{};
+      return one;
+    }
+    if (p.size + kBundleEntryHeaderBytes + one.payload.size > p.bytes.size()) {
+      out.payload = Payload{};
+      out.error = EncodeError::kTooLarge;
+      return out;
+    }
+    p.bytes[p.size] = static_cast<std::uint8_t>(one.payload.size);
+    std::copy_n(one.payload.bytes.begin(), one.payload.size, p.bytes.begin() + static_cast<std::ptrdiff_t>(p.size) + 1);
+    p.size += kBundleEntryHeaderBytes + one.payload.size;
+  }
+  return out;
+}
+
 }  // namespace railproof::messages

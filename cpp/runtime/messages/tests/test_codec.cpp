@@ -154,12 +154,13 @@ TEST(MessagesCodec, EnumNames) {
   }
   testing::ExpectEnumNames<DecodeError, 10>({"NONE", "EMPTY", "UNKNOWN_TYPE", "WRONG_LENGTH", "TOO_MANY_ENTRIES",
                                              "OUT_OF_RANGE", "BAD_ENUM", "BAD_FLAG", "EMPTY_RANGE", "UNSORTED"});
-  testing::ExpectEnumNames<EncodeError, 4>({"NONE", "NO_MESSAGE", "INVALID_MESSAGE", "NOT_REPRESENTABLE"});
-  testing::ExpectEnumNames<Field, 20>({"none", "offset_mm", "length_mm", "correction_mm", "last_balise_mm",
+  testing::ExpectEnumNames<EncodeError, 5>(
+      {"NONE", "NO_MESSAGE", "INVALID_MESSAGE", "NOT_REPRESENTABLE", "TOO_LARGE"});
+  testing::ExpectEnumNames<Field, 21>({"none", "offset_mm", "length_mm", "correction_mm", "last_balise_mm",
                                        "speed_mm_s", "direction", "limit_mm", "kind", "restriction_count",
                                        "restrictions_truncated", "restriction.begin_mm", "restriction.end_mm",
                                        "restriction.speed_mm_s", "restriction order", "status", "clock_fault",
-                                       "requester_count", "front_mm", "rear_mm"});
+                                       "requester_count", "front_mm", "rear_mm", "bundle count"});
 }
 
 // The POSITION and CONTROL payloads keep the lengths of the line simulator's former coding (its
@@ -602,6 +603,127 @@ TEST(MessagesCodec, CorruptedTypeByte) {
   }
 }
 
+// ---- bundles -------------------------------------------------------------------------------------
+
+// A position report with two crossing requests, as the on-board unit sends them in one telegram.
+std::vector<Message> UplinkBundle() {
+  return {Message{test::PositionMax()}, Message{CrossingRequest{7, 3}}, Message{CrossingWithdrawal{{7, 4}}}};
+}
+
+// @verifies REQ-MB-001 REQ-LC-002 REQ-LC-004
+TEST(MessagesCodec, BundleRoundTripsWithItsDocumentedLayout) {
+  const std::vector<Message> msgs = UplinkBundle();
+  const Encoded e = EncodeBundle(msgs);
+  ASSERT_TRUE(e.Ok()) << ToString(e.error);
+  Bytes expected = {kBundleType, 3};
+  for (const Message& m : msgs) {
+    const Bytes one = Layout(m);
+    expected.push_back(static_cast<std::uint8_t>(one.size()));
+    expected.insert(expected.end(), one.begin(), one.end());
+  }
+  EXPECT_EQ(ToBytes(e.payload), expected);
+  EXPECT_EQ(BundleSize(msgs), e.payload.size);
+  EXPECT_EQ(e.payload.size, 2U + 51U + 10U + 10U);
+  const DecodedBundle d = DecodeBundle(e.payload.View());
+  ASSERT_TRUE(d.Ok()) << ToString(d.error) << " entry " << d.entry;
+  ASSERT_EQ(d.bundle.size, msgs.size());
+  for (std::size_t i = 0; i < msgs.size(); ++i) {
+    EXPECT_EQ(Describe(d.bundle.View()[i]), Describe(msgs[i])) << "entry " << i;
+  }
+}
+
+// One message is its plain payload both ways, so a unit reads single-message telegrams too.
+TEST(MessagesCodec, BundleOfOneIsThePlainPayload) {
+  for (const auto& s : BoundarySamples()) {
+    SCOPED_TRACE(s.name);
+    const std::array<Message, 1> one = {s.message};
+    EXPECT_EQ(ToBytes(EncodeBundle(one).payload), ToBytes(Encode(s.message).payload));
+    EXPECT_EQ(BundleSize(one), EncodedSize(s.message));
+    const DecodedBundle d = DecodeBundle(Encode(s.message).payload.View());
+    ASSERT_TRUE(d.Ok());
+    ASSERT_EQ(d.bundle.size, 1U);
+    EXPECT_EQ(Describe(d.bundle.View()[0]), Describe(s.message));
+  }
+  EXPECT_EQ(Decode(EncodeBundle(UplinkBundle()).payload.View()).error, DecodeError::kUnknownType)
+      << "a single-message reader does not take a bundle for a message";
+}
+
+TEST(MessagesCodec, BundleEncodeRefusals) {
+  EXPECT_EQ(EncodeBundle({}).error, EncodeError::kNoMessage);
+  EXPECT_EQ(BundleSize({}), 0U);
+  const std::vector<Message> nine(kBundleMax + 1, Message{KeepAlive{}});
+  EXPECT_EQ(EncodeBundle(nine).error, EncodeError::kTooLarge);
+  const std::vector<Message> eight(kBundleMax, Message{KeepAlive{}});
+  EXPECT_TRUE(EncodeBundle(eight).Ok());
+  // a full stop-limit telegram (120 bytes) leaves no room for a position report
+  const std::vector<Message> big = {Message{test::StopLimitMax()}, Message{test::PositionMax()}};
+  EXPECT_GT(BundleSize(big), kPayloadCapacity);
+  const Encoded too_large = EncodeBundle(big);
+  EXPECT_EQ(too_large.error, EncodeError::kTooLarge);
+  EXPECT_EQ(too_large.payload.size, 0U);
+  // a refused message refuses the bundle with its own reason
+  PositionReport bad = test::PositionMax();
+  bad.length_mm = 0;
+  const std::vector<Message> with_bad = {Message{KeepAlive{}}, Message{bad}};
+  const Encoded refused = EncodeBundle(with_bad);
+  EXPECT_EQ(refused.error, EncodeError::kInvalidMessage);
+  EXPECT_EQ(refused.field, Field::kLength);
+  EXPECT_EQ(refused.payload.size, 0U);
+  EXPECT_EQ(BundleSize(with_bad), 0U);
+}
+
+TEST(MessagesCodec, BundleDecodeRejections) {
+  const Bytes good = ToBytes(EncodeBundle(UplinkBundle()).payload);
+  const auto decode = [](const Bytes& b) { return DecodeBundle(b); };
+  EXPECT_EQ(decode({}).error, DecodeError::kEmpty);
+  EXPECT_EQ(decode({kBundleType}).error, DecodeError::kWrongLength);
+  for (const std::uint8_t n : std::array<std::uint8_t, 4>{0, 1, 9, 255}) {
+    Bytes b = good;
+    b[1] = n;
+    const DecodedBundle d = decode(b);
+    EXPECT_EQ(d.error, DecodeError::kTooManyEntries) << "n = " << int{n};
+    EXPECT_EQ(d.field, Field::kBundleCount);
+  }
+  // every cut is rejected, naming the entry it falls in; nothing is returned
+  for (std::size_t cut = 2; cut < good.size(); ++cut) {
+    const DecodedBundle d = decode(Bytes(good.begin(), good.begin() + static_cast<std::ptrdiff_t>(cut)));
+    EXPECT_FALSE(d.Ok()) << "cut at " << cut;
+    EXPECT_EQ(d.bundle.size, 0U);
+  }
+  Bytes trailing = good;
+  trailing.push_back(0);
+  EXPECT_EQ(decode(trailing).error, DecodeError::kWrongLength);
+  // well-formed entries, but more bytes than a telegram carries (EncodeBundle refuses it)
+  Bytes oversized = {kBundleType, 3};
+  for (int i = 0; i < 3; ++i) {
+    const Bytes report = Layout(Message{test::PositionMax()});
+    oversized.push_back(static_cast<std::uint8_t>(report.size()));
+    oversized.insert(oversized.end(), report.begin(), report.end());
+  }
+  ASSERT_GT(oversized.size(), kPayloadCapacity);
+  EXPECT_EQ(decode(oversized).error, DecodeError::kWrongLength);
+  // an entry's own error, with its index: the second entry's type byte corrupted
+  Bytes bad_entry = good;
+  bad_entry[2 + 51 + 1] = 42;
+  const DecodedBundle d = decode(bad_entry);
+  EXPECT_EQ(d.error, DecodeError::kUnknownType);
+  EXPECT_EQ(d.entry, 1U);
+  // a field error inside an entry keeps its field
+  Bytes bad_direction = good;
+  bad_direction[2 + 50] = 2;  // the report's direction byte
+  const DecodedBundle dd = decode(bad_direction);
+  EXPECT_EQ(dd.error, DecodeError::kBadEnum);
+  EXPECT_EQ(dd.field, Field::kDirection);
+  EXPECT_EQ(dd.entry, 0U);
+  // no bundle inside a bundle
+  Bytes nested = {kBundleType, 2, static_cast<std::uint8_t>(good.size())};
+  nested.insert(nested.end(), good.begin(), good.end());
+  nested.insert(nested.end(), {1, static_cast<std::uint8_t>(MessageType::kKeepAlive)});
+  const DecodedBundle dn = decode(nested);
+  EXPECT_EQ(dn.error, DecodeError::kUnknownType);
+  EXPECT_EQ(dn.entry, 0U);
+}
+
 // ---- no heap ------------------------------------------------------------------------------------
 
 // @verifies REQ-MB-021
@@ -612,6 +734,7 @@ TEST(MessagesCodec, NoAllocation) {
   for (const Invalid& c : invalid) {
     invalid_bytes.push_back(Layout(c.message));
   }
+  const std::vector<Message> uplink = UplinkBundle();
   std::size_t ok = 0;
   railproof::testing::StartCountingAllocations();
   for (const auto& s : samples) {
@@ -622,8 +745,9 @@ TEST(MessagesCodec, NoAllocation) {
     ok += Encode(invalid[i].message).Ok() ? 1U : 0U;
     ok += Decode(invalid_bytes[i]).Ok() ? 1U : 0U;
   }
+  ok += DecodeBundle(EncodeBundle(uplink).payload.View()).Ok() ? 1U : 0U;
   EXPECT_EQ(railproof::testing::StopCountingAllocations(), 0U);
-  EXPECT_EQ(ok, samples.size() + 1U);  // the samples, and the 7 restrictions the encoder truncates
+  EXPECT_EQ(ok, samples.size() + 2U);  // the samples, the 7 restrictions the encoder truncates, the bundle
   // the counter sees a copy of the samples (otherwise the zero above would say nothing)
   railproof::testing::StartCountingAllocations();
   const std::vector<test::Sample> copy = samples;

@@ -24,6 +24,9 @@
 //     u8 type | u32 crossing_id | u32 train_id
 //   9 CENTRE_POSITION_REPORT (train -> centre, CentrePositionReport), 37 bytes:
 //     u8 type | u32 train_id | i64 time_ms | i64 front_mm | i64 rear_mm | i64 speed_mm_s
+//  10 BUNDLE (either way: several messages in one telegram), 2 + sum(1 + size_i) bytes:
+//     u8 type | u8 n (2 .. kBundleMax) | n x (u8 size_i | the payload of message i, types 1..9)
+//     A bundle of one message is that message's plain payload; a bundle holds no bundle.
 //
 // Ranges (checked by Decode, and by Encode before it writes a byte; core/units.hpp):
 //   positions (last_balise_mm, limit_mm, front_mm, rear_mm)  |x| <= core::kMaxPositionMm
@@ -127,15 +130,16 @@ enum class Field : std::uint8_t {
   kRequesterCount,    // n of CROSSING_REPORT, requester_count
   kFront,             // front_mm
   kRear,              // rear_mm
+  kBundleCount,       // n of a BUNDLE
 };
 
 constexpr const char* ToString(Field f) noexcept {
-  return core::EnumName(f, std::array<const char*, 20>{
+  return core::EnumName(f, std::array<const char*, 21>{
                                "none", "offset_mm", "length_mm", "correction_mm", "last_balise_mm", "speed_mm_s",
                                "direction", "limit_mm", "kind", "restriction_count", "restrictions_truncated",
                                "restriction.begin_mm", "restriction.end_mm", "restriction.speed_mm_s",
                                "restriction order", "status", "clock_fault", "requester_count", "front_mm",
-                               "rear_mm"});
+                               "rear_mm", "bundle count"});
 }
 
 // Why a payload is not a message, checked in this order: kEmpty, kUnknownType, kWrongLength
@@ -165,10 +169,12 @@ enum class EncodeError : std::uint8_t {
   kNoMessage,         // std::monostate
   kInvalidMessage,    // a value the decoder would reject (`invalid`, `field`)
   kNotRepresentable,  // a valid value the layout cannot hold (a restriction bound outside int32)
+  kTooLarge,          // a bundle of more than kBundleMax messages or kPayloadCapacity bytes
 };
 
 constexpr const char* ToString(EncodeError e) noexcept {
-  return core::EnumName(e, std::array<const char*, 4>{"NONE", "NO_MESSAGE", "INVALID_MESSAGE", "NOT_REPRESENTABLE"});
+  return core::EnumName(e, std::array<const char*, 5>{"NONE", "NO_MESSAGE", "INVALID_MESSAGE", "NOT_REPRESENTABLE",
+                                                      "TOO_LARGE"});
 }
 
 // An encoded message: the first `size` bytes of `bytes`.
@@ -206,5 +212,52 @@ struct Encoded {
 // The payload of a message, or why there is none: Decode(Encode(m).payload.View()) gives m
 // back (with at most kWireRestrictionsMax restrictions, `truncated` set if any were left out).
 [[nodiscard]] Encoded Encode(const Message& message) noexcept;
+
+// ---- Bundles: the messages one telegram carries (a unit sends one telegram per cycle of its
+// telegram layer: the position report or stop limit first, then the crossing messages that fit).
+
+inline constexpr std::uint8_t kBundleType = 10;
+inline constexpr std::size_t kBundleMax = 8;
+
+// Up to kBundleMax messages, in order.
+struct Bundle {
+  std::array<Message, kBundleMax> messages{};
+  std::size_t size = 0;
+  [[nodiscard]] std::span<const Message> View() const noexcept { return {messages.data(), size}; }
+  // Appends m; false (and no change) when the bundle is full.
+  [[nodiscard]] bool Add(const Message& m) noexcept {
+    if (size >= kBundleMax) {
+      return false;
+    }
+    messages[size] = m;
+    ++size;
+    return true;
+  }
+};
+
+struct DecodedBundle {
+  Bundle bundle;                          // empty unless error == kNone
+  DecodeError error = DecodeError::kNone;
+  Field field = Field::kNone;             // as Decoded::field; kBundleCount for a bad n
+  std::size_t entry = 0;                  // the message the error is in (0 for the bundle's own bytes)
+  [[nodiscard]] bool Ok() const noexcept { return error == DecodeError::kNone; }
+};
+
+// The payload bytes Encode(m) writes (0 if m is no message or is refused).
+[[nodiscard]] std::size_t EncodedSize(const Message& m) noexcept;
+
+// The payload bytes EncodeBundle(messages) writes (0 for no message or a refused one); may
+// exceed kPayloadCapacity (then EncodeBundle refuses).
+[[nodiscard]] std::size_t BundleSize(std::span<const Message> messages) noexcept;
+
+// The messages of a payload: a plain payload (types 1..9) is a bundle of one; a BUNDLE is read
+// entry by entry, each with Decode. Whole or nothing: any error leaves the bundle empty.
+// Errors: those of Decode (the entry's, with `entry`), kWrongLength for a bundle whose entries do
+// not fill it exactly or that is longer than kPayloadCapacity, kTooManyEntries (kBundleCount) for n < 2 or n > kBundleMax.
+[[nodiscard]] DecodedBundle DecodeBundle(std::span<const std::uint8_t> payload) noexcept;
+
+// One payload for the messages: the plain payload of a single message, else a BUNDLE; refused
+// with the first refused message's error, kNoMessage for none, kTooLarge when over capacity.
+[[nodiscard]] Encoded EncodeBundle(std::span<const Message> messages) noexcept;
 
 }  // namespace railproof::messages
