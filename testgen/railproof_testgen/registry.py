@@ -93,6 +93,13 @@ class Capability:
 class Registry:
     file: Path
     capabilities: list
+    # The units' glue (cpp/runtime/units): a pseudo-capability "units" that only has faults.
+    units: Capability | None = None
+
+    @property
+    def fault_owners(self) -> list:
+        """Everything that owns seeded faults: the capabilities, then the units."""
+        return self.capabilities + ([self.units] if self.units else [])
 
     def by_name(self, name: str) -> Capability:
         for c in self.capabilities:
@@ -139,7 +146,12 @@ def load(spec_dir: Path) -> Registry:
             proofs=bool(c.get("proofs")),
             faults=[Fault(f["id"], f["text"], list(f["killed_by"])) for f in c.get("faults") or []],
             studies=list(c.get("studies") or [])))
-    return Registry(path, caps)
+    units = None
+    if data.get("units"):
+        u = data["units"]
+        units = Capability(name="units", title=u["title"], sources=[], areas=["UNIT"],
+                           faults=[Fault(f["id"], f["text"], list(f["killed_by"])) for f in u["faults"]])
+    return Registry(path, caps, units)
 
 
 def model_configurations(model_path: Path) -> list:
@@ -257,7 +269,7 @@ class Checker:
             cap = src.relative_to(self.repo / "cpp" / "runtime").parts[0]
             for m in _FAULT_USE.finditer(src.read_text(encoding="utf-8")):
                 used.setdefault(m.group(1), set()).add(cap)
-        for c in self.reg.capabilities:
+        for c in self.reg.fault_owners:
             seen = set()
             for flt in c.faults:
                 if flt.id in seen:
@@ -271,9 +283,8 @@ class Checker:
                     self.err(f, flt.id, "killed_by vectors needs a model and a conformance runner")
         for fid, caps in sorted(used.items()):
             for cap in sorted(caps):
-                try:
-                    owner = self.reg.by_name(cap)
-                except KeyError:
+                owner = next((o for o in self.reg.fault_owners if o.name == cap), None)
+                if owner is None:
                     continue
                 if owner.fault(fid) is None:
                     self.err(f"cpp/runtime/{cap}/src", fid, f"seeded fault not registered under {cap}")
@@ -310,7 +321,7 @@ def cmake_text(reg: Registry) -> str:
     """CMake variables for the build (cpp/CMakeLists.txt, cmake/RailproofPipeline.cmake)."""
     out = ["# Generated from spec/capabilities.yaml by railproof_testgen registry. Do not edit.",
            f"set(RAILPROOF_CAPABILITIES {' '.join(c.name for c in reg.capabilities)})"]
-    for c in reg.capabilities:
+    for c in reg.fault_owners:
         p = f"RAILPROOF_CAP_{c.name}"
         out += [f"set({p}_AREAS {' '.join(c.areas)})",
                 f"set({p}_MODELS {' '.join(m.name for m in c.models)})",
@@ -326,7 +337,7 @@ def cmake_text(reg: Registry) -> str:
 
 def faults_header(reg: Registry) -> str:
     """The seeded-fault identifiers for the mutant-schemata build (railproof/core/seeded_fault.hpp)."""
-    ids = [x.id for c in reg.capabilities for x in c.faults]
+    ids = [x.id for c in reg.fault_owners for x in c.faults]
     lines = ["// Generated from spec/capabilities.yaml by railproof_testgen registry. Do not edit.",
              "// The seeded faults of every capability (railproof/core/seeded_fault.hpp).",
              "#pragma once", "", "#include <array>", "#include <cstdint>", "#include <string_view>", "",
@@ -362,7 +373,10 @@ def run(args) -> int:
              "design": c.design, "chapter": c.chapter, "runtime_parts": c.parts,
              "conformance": c.conformance, "proofs": c.proofs, "studies": c.studies,
              "faults": [{"id": x.id, "text": x.text, "killed_by": x.killed_by} for x in c.faults]}
-            for c in reg.capabilities]}
+            for c in reg.capabilities],
+            "units": {"name": "units", "title": reg.units.title if reg.units else "",
+                      "faults": [{"id": x.id, "text": x.text, "killed_by": x.killed_by}
+                                 for x in (reg.units.faults if reg.units else [])]}}
         write_atomic(Path(args.json), json.dumps(data, indent=2, sort_keys=True) + "\n")
     return 0
 

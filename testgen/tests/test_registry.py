@@ -64,6 +64,15 @@ def test_cmake_variables_and_fault_identifiers_come_from_the_registry(cli, tmp_p
     # a fault named after another area
     (("spec/capabilities.yaml", "id: FAULT_LC_STALE_CONFIRMATION", "id: FAULT_MB_STALE_CONFIRMATION"),
      "spec/capabilities.yaml", "FAULT_MB_STALE_CONFIRMATION", "a fault of lc is named FAULT_<area>_"),
+    # a fault of the units' glue without a site in cpp/runtime/units/src, and one of another area
+    (("spec/capabilities.yaml", "\ncapabilities:\n",
+      "\nunits:\n  title: the units\n  faults:\n    - {id: FAULT_UNIT_NOWHERE, text: no site, killed_by: [unit]}\n"
+      "capabilities:\n"),
+     "spec/capabilities.yaml", "FAULT_UNIT_NOWHERE", "no RAILPROOF_FAULT(FAULT_UNIT_NOWHERE) in cpp/runtime/units/src"),
+    (("spec/capabilities.yaml", "\ncapabilities:\n",
+      "\nunits:\n  title: the units\n  faults:\n    - {id: FAULT_TG_GLUE, text: misnamed, killed_by: [unit]}\n"
+      "capabilities:\n"),
+     "spec/capabilities.yaml", "FAULT_TG_GLUE", "a fault of units is named FAULT_<area>_... (UNIT)"),
     # a name that is not the first area in lower case
     (("spec/capabilities.yaml", "  - name: ra\n", "  - name: rx\n"),
      "spec/capabilities.yaml", "rx", "the name must be the lower-case first area (ra)"),

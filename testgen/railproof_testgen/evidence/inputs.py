@@ -48,6 +48,7 @@ class Inputs:
     results_dir: Path
     repo_root: Path
     registry: list = field(default_factory=list)       # capability entries of registry.json
+    fault_owners: list = field(default_factory=list)   # the capabilities and the units, each with its faults
     requirements: list = field(default_factory=list)
     hazards: list = field(default_factory=list)
     assumptions: list = field(default_factory=list)
@@ -196,6 +197,10 @@ def load_registry(inp: Inputs) -> None:
         for key in ("title", "design", "chapter"):
             require(isinstance(c.get(key), str), path, c["name"], f"'{key}' must be a string")
     inp.registry = caps
+    units = data.get("units") or {}
+    require(isinstance(units, dict) and isinstance(units.get("faults", []), list), path, "units",
+            "must be an object with a list of 'faults'")
+    inp.fault_owners = caps + [{"name": "units", "title": units.get("title", ""), "faults": units.get("faults", [])}]
 
 
 def load_trace(inp: Inputs) -> None:

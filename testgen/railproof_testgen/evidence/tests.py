@@ -123,7 +123,7 @@ def collect(ctx) -> None:
     ctx.own_rendered = 0
     ctx.test_totals = _counts()
     ctx.unit_cases = {}            # "Suite.Test" -> [(test set, case need id)]
-    ctx.fault_by_id = {f["id"]: f for c in ctx.inp.registry for f in c["faults"]}
+    ctx.fault_by_id = {f["id"]: f for c in ctx.inp.fault_owners for f in c["faults"]}
     ctx.entries = []
     groups: dict = {}
     for e in run.entries:
@@ -304,7 +304,7 @@ def _faults(ctx) -> None:
     run = ctx.inp.tests
     entries = {e.name: e for e in run.entries}
     ctx.faults = []
-    for cap in ctx.inp.registry:
+    for cap in ctx.inp.fault_owners:
         for f in cap["faults"]:
             fid = ctx.claim(f["id"], "seeded fault")
             kills, reasons = [], []
