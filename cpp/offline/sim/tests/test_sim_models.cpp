@@ -1,8 +1,12 @@
-// Unit tests of the simulation's models: the seeded channel (the train-motion model is tested
-// in offline/common).
+// Unit tests of the simulation's models: the seeded channel and the sensor model (the
+// train-motion model is tested in offline/common).
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
+#include <memory>
+#include <optional>
 #include <cstdint>
 #include <span>
 #include <string>
@@ -10,7 +14,10 @@
 
 #include "railproof/tg/frame.hpp"
 #include "railproof/tg/telegram.hpp"
+#include "railproof/generated/ra_params.hpp"
+#include "railproof/ra/odometry.hpp"
 #include "railproof/sim/channel.hpp"
+#include "railproof/sim/sensors.hpp"
 
 namespace railproof::sim {
 namespace {
@@ -131,6 +138,81 @@ TEST(SimChannel, CorruptedFramesAreCorrectedOrRejectedByTheFrameDecoder) {
   EXPECT_GT(corrected, 0);
   EXPECT_GT(rejected, 0);
   EXPECT_EQ(ch.Stats(Direction::kUplink).corrupted, 400U);
+}
+
+// ---- sensors ---------------------------------------------------------------------------
+
+// The warm-up at standstill the odometry needs after its start (REQ-RA-015).
+constexpr int kWarmupCycles =
+    static_cast<int>((params::ra::moving_average_ms + params::ra::tg_window_ms) / params::ra::cycle_ms);
+
+// A train on a level line with its odometry fed by the sensor model: it stands for the
+// odometry's warm-up, accelerates, cruises over a balise, brakes to a stop. Every cycle's data
+// is accepted, the position stays valid with no stop demand, and the true front lies inside
+// the odometry's envelope at every cycle.
+// @verifies REQ-RA-013 REQ-RA-015
+TEST(SimSensors, TheOdometryTracksTheTrueMotionInsideItsEnvelope) {
+  const std::array<ra::OdometrySection, 1> level = {{{0, 20'000'000, 0, 10'000, 0}}};
+  ra::OdometryConfig oc;
+  oc.train_length_mm = 60'000;
+  oc.sections = level.data();
+  oc.section_count = 1;
+  oc.initial_front_mm = 1'000'000;
+  auto od = std::make_unique<ra::Odometry>();
+  ASSERT_EQ(ra::Odometry::Create(oc, *od), ra::ConfigError::kNone);
+  for (const std::uint64_t seed : {1U, 2U, 3U}) {
+    SensorConfig sc;
+    sc.seed = seed;
+    SensorModel sensors(sc);
+    EXPECT_LE(std::abs(sensors.diameter_error()), 0.9e-3);
+    ASSERT_EQ(ra::Odometry::Create(oc, *od), ra::ConfigError::kNone);
+    offline::Motion truth{1000.0, 0.0};
+    std::int64_t t = 0;
+    double worst_outside = 0.0;
+    bool balise_passed = false;
+    for (int k = 0; k < 1200; ++k) {  // 120 s
+      t += 100;
+      const double a = k < 60 ? 0.0 : (k < 260 ? 0.5 : (k < 900 ? 0.0 : -0.8));
+      TrueCycle c{t, truth, a, 0.0, std::nullopt};
+      const offline::Motion next = offline::Advance(truth, a, 0.1);
+      if (!balise_passed && next.position >= 1500.0) {
+        balise_passed = true;
+        c.balise_mm = 1'500'000;  // the fix of the balise the front passed (the odometry's reference point)
+      }
+      const ra::OdometryOutput& o = od->Step(sensors.Cycle(c));
+      truth = next;
+      ASSERT_EQ(o.input_error, ra::InputError::kNone) << "seed " << seed << " cycle " << k;
+      if (k < kWarmupCycles) {
+        continue;  // start-up: the odometry trusts its history after the warm-up (REQ-RA-015)
+      }
+      ASSERT_TRUE(o.position_valid) << "seed " << seed << " cycle " << k;
+      EXPECT_FALSE(o.stop_demand) << "seed " << seed << " cycle " << k;
+      const double lo = static_cast<double>(o.front_mm) / 1000.0 - static_cast<double>(o.rear_error_mm) / 1000.0;
+      const double hi = static_cast<double>(o.front_mm + o.front_error_mm) / 1000.0;
+      worst_outside = std::max({worst_outside, lo - truth.position, truth.position - hi});
+    }
+    EXPECT_TRUE(balise_passed);
+    EXPECT_EQ(truth.speed, 0.0);
+    EXPECT_LE(worst_outside, 0.0) << "seed " << seed << ": the true front left the envelope by " << worst_outside << " m";
+    EXPECT_GT(truth.position, 1500.0);
+  }
+}
+
+// The streams follow the true motion: the pulse count is the wheel's distance over its true
+// pulse length, the last edge lies in the cycle, and the IMU reads gravity on a gradient.
+TEST(SimSensors, StreamsFollowTheTrueMotion) {
+  SensorConfig sc;
+  sc.imu_noise_mps2 = 0.0;
+  sc.imu_rate_noise_rad_s = 0.0;
+  SensorModel s(sc);
+  const offline::Motion m{0.0, 10.0};
+  const ra::CycleInput in = s.Cycle(TrueCycle{100, m, 0.0, 20.0, std::nullopt});
+  EXPECT_EQ(in.tg.pulses, static_cast<std::int64_t>(std::floor(1.0 / s.true_pulse_m())));
+  EXPECT_GT(in.tg.last_edge_us, 0);
+  EXPECT_LE(in.tg.last_edge_us, 100'000);
+  EXPECT_NEAR(in.imu[0].ax, offline::kGravity * std::sin(std::atan(0.02)), 1e-12);
+  EXPECT_EQ(in.imu[9].time_us, 100'000);
+  EXPECT_NEAR(s.nominal_pulse_m(), 3.14159265 * 0.86 / 90.0, 1e-6);
 }
 
 }  // namespace
