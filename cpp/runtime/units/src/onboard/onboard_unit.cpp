@@ -1,0 +1,467 @@
+// The on-board unit's cycle (onboard_unit.hpp, spec/design/units.md). The glue implements
+// no requirement of its own except the position report built from the envelope (Report);
+// elsewhere it connects the modules that implement them, named where they meet.
+#include "railproof/units/onboard_unit.hpp"
+
+#include <algorithm>
+#include <limits>
+#include <variant>
+
+#include "railproof/core/seeded_fault.hpp"
+#include "railproof/units/onboard_profile.hpp"
+
+namespace railproof::units {
+
+namespace {
+
+bool MultipleOfCycle(std::int64_t ms) noexcept { return ms > 0 && ms % kOnboardCycleMs == 0; }
+
+// Copies `from` into `to`, allocated to its size (at least 1 so that a span is never dangling).
+template <typename T>
+bool CopyInto(std::span<const T> from, core::FixedVector<T>& to) noexcept {
+  if (!to.Allocate(std::max<std::size_t>(from.size(), 1))) {
+    return false;  // GCOVR_EXCL_LINE defensive: out of memory at initialisation
+  }
+  for (const T& x : from) {
+    (void)to.PushBack(x);
+  }
+  return true;
+}
+
+ConfigCheck Fail(ConfigError e, std::size_t entry = 0) noexcept {
+  ConfigCheck c;
+  c.error = e;
+  c.entry = entry;
+  return c;
+}
+
+}  // namespace
+
+OnboardCreateResult OnboardUnit::Create(const OnboardConfig& config) noexcept {
+  OnboardCreateResult r;
+  r.unit.emplace(Token{});
+  r.check = r.unit->Init(config);
+  if (r.check.error != ConfigError::kNone) {
+    r.unit.reset();
+  }
+  return r;
+}
+
+ConfigCheck OnboardUnit::Init(const OnboardConfig& c) noexcept {
+  if (!MultipleOfCycle(c.supervision.cycle_ms) || !MultipleOfCycle(c.radio_period_ms) || c.radio_offset_ms < 0 ||
+      c.radio_offset_ms % kOnboardCycleMs != 0 || c.radio_offset_ms >= c.radio_period_ms) {
+    return Fail(ConfigError::kPeriods);
+  }
+  const auto blocks = c.line.blocks_mm;
+  if (blocks.size() < 2 || blocks[0] != 0) {
+    return Fail(ConfigError::kBlocks);
+  }
+  for (std::size_t i = 1; i < blocks.size(); ++i) {
+    if (blocks[i] <= blocks[i - 1] || blocks[i] > core::kMaxPositionMm) {
+      return Fail(ConfigError::kBlocks, i);
+    }
+  }
+  const auto balises = c.line.balises;
+  for (std::size_t i = 0; i < balises.size(); ++i) {
+    const bool on_line = balises[i].position_mm >= 0 && balises[i].position_mm <= blocks.back();
+    const bool twice = std::any_of(balises.begin(), balises.begin() + static_cast<std::ptrdiff_t>(i),
+                                   [&](const BaliseEntry& b) { return b.id == balises[i].id; });
+    if (!on_line || twice) {
+      return Fail(ConfigError::kBalises, i);
+    }
+  }
+  if (!CopyInto(blocks, blocks_) || !CopyInto(balises, balises_) || !CopyInto(c.line.gradients, gradients_) ||
+      !CopyInto(c.line.speed_limits, line_limits_) || !CopyInto(c.line.odometry_sections, sections_)) {
+    return Fail(ConfigError::kOutOfMemory);  // GCOVR_EXCL_LINE defensive
+  }
+  train_id_ = c.train_id;
+  length_mm_ = c.train.length_mm;
+  radio_period_ms_ = c.radio_period_ms;
+  radio_offset_ms_ = c.radio_offset_ms;
+  supervision_period_ms_ = c.supervision.cycle_ms;
+
+  ra::OdometryConfig oc = c.odometry;
+  oc.train_length_mm = c.train.length_mm;
+  oc.sections = sections_.Span().data();
+  oc.section_count = static_cast<int>(c.line.odometry_sections.size());
+  oc.initial_front_mm = c.initial_front_mm;
+  if (const ra::ConfigError e = ra::Odometry::Create(oc, odometry_); e != ra::ConfigError::kNone) {
+    ConfigCheck check = Fail(ConfigError::kOdometry);
+    check.odometry = e;
+    return check;
+  }
+  last_store_front_mm_ = c.initial_front_mm;
+
+  const std::size_t capacity = std::max({c.line.gradients.size(), MergeCapacity(c.line.speed_limits.size(),
+                                                                                mb::onboard::kStoredRestrictionsMax),
+                                         std::size_t{1}});
+  auto created = br::PatternCalculator::Create(c.train, c.supervision, std::min(capacity, core::kMaxProfileCapacity));
+  if (created.error != br::CreateError::kNone) {
+    ConfigCheck check = Fail(ConfigError::kTrainData);
+    check.braking = created.error;
+    return check;
+  }
+  patterns_.emplace(std::move(*created.calculator));
+  if (const br::ProfileResult p = patterns_->SetProfile(gradients_.Span(), line_limits_.Span());
+      p.verdict != br::ProfileVerdict::kAccept) {
+    ConfigCheck check = Fail(ConfigError::kLineProfile, p.entry);
+    check.profile = p;
+    return check;
+  }
+  const std::size_t merged = MergeCapacity(c.line.speed_limits.size(), mb::onboard::kStoredRestrictionsMax);
+  if (!profile_.Allocate(merged) || !scratch_.Allocate(merged) || !scratch_.Resize(merged)) {
+    return Fail(ConfigError::kOutOfMemory);  // GCOVR_EXCL_LINE defensive
+  }
+
+  lc::onboard::ProtectionConfig pc = c.crossing;
+  pc.train_id = c.train_id;
+  pc.train_length_mm = c.train.length_mm;
+  pc.accel_max_mm_s2 = c.train.accel_max_mm_s2;
+  auto protection = lc::onboard::CrossingProtection::Create(pc);
+  lc::onboard::ProtectionError pe = protection.error;
+  if (pe == lc::onboard::ProtectionError::kNone) {
+    crossings_.emplace(*protection.protection);
+    pe = crossings_->LoadCrossings(c.line.crossings);
+  }
+  if (pe != lc::onboard::ProtectionError::kNone) {
+    ConfigCheck check = Fail(ConfigError::kCrossings);
+    check.crossings = pe;
+    return check;
+  }
+
+  authority_ = mb::onboard::AuthorityReceiver(c.authority);
+  if (c.radio.role != tg::Role::kTrain || !c.link_key) {
+    return Fail(ConfigError::kRadio);
+  }
+  if (const tg::ConfigError e = endpoint_.Init(c.radio, *c.link_key); e != tg::ConfigError::kNone) {
+    ConfigCheck check = Fail(ConfigError::kRadio);
+    check.radio = e;
+    return check;
+  }
+  return {};
+}
+
+// ---- the cycle -----------------------------------------------------------------------------
+
+const OnboardOutputs& OnboardUnit::Cycle(const OnboardInputs& in) noexcept {
+  out_.now_ms = in.now_ms;
+  out_.sent = false;
+  out_.frame.size = 0;
+  out_.crossing_messages_sent = 0;
+  out_.encode_error = messages::EncodeError::kNone;
+  out_.event_count = 0;
+  out_.unknown_balise = false;
+
+  // 1. odometry (the balise read becomes the fix of the track database)
+  ra::CycleInput sensors = in.sensors;
+  sensors.time_ms = in.now_ms;
+  sensors.balise.reset();
+  if (in.balise_id) {
+    const auto it = std::find_if(balises_.begin(), balises_.end(),
+                                 [&](const BaliseEntry& b) { return b.id == *in.balise_id; });
+    if (it != balises_.end()) {
+      sensors.balise = ra::BaliseFix{it->position_mm};
+    } else {
+      out_.unknown_balise = true;
+    }
+  }
+  const ra::OdometryOutput& o = odometry_.Step(sensors);
+  out_.position_valid = o.position_valid;
+  out_.front_mm = o.front_mm;
+  out_.front_error_mm = o.front_error_mm;
+  out_.rear_error_mm = o.rear_error_mm;
+  out_.speed_mm_s = o.speed_mm_s;
+  out_.sensor_error = o.input_error;
+
+  // 2. the held restrictions apply until the rear has left them (REQ-MB-015)
+  if (o.position_valid) {
+    last_store_front_mm_ = StoreFront(o);
+  }
+  restrictions_.Advance(last_store_front_mm_, length_mm_);
+
+  // 3. the telegram of this cycle
+  if (!next_radio_ms_) {
+    next_radio_ms_ = in.now_ms + radio_offset_ms_;
+    next_supervision_ms_ = in.now_ms;
+  }
+  if (in.now_ms >= *next_radio_ms_) {
+    Send(o);
+    *next_radio_ms_ += radio_period_ms_;
+  }
+
+  // 4. what arrived
+  Receive(in);
+  out_.link = endpoint_.Link();
+  out_.authority_usable = authority_.Usable(in.now_ms);
+  out_.authority_limit_mm = authority_.Limit();
+
+  // 5.-7.
+  UpdateProfile();
+  Protect(in, o);
+  if (in.now_ms >= *next_supervision_ms_) {
+    Supervise(o, in.driver);
+    *next_supervision_ms_ += supervision_period_ms_;
+  }
+  Demand(o);
+  return out_;
+}
+
+// The front the restriction store measures the rear from: the rearmost the front may be
+// (REQ-MB-015: until the rear has left; rear_min = front - length - rear_error, REQ-RA-012).
+std::int64_t OnboardUnit::StoreFront(const ra::OdometryOutput& o) const noexcept {
+  return o.front_mm - o.rear_error_mm;
+}
+
+// The position report of the envelope (REQ-MB-001): the nominal front as virtual block and
+// offset (the block holding the foremost millimetre), the correction covering both ends of the
+// envelope (ra::ReportCorrectionMm: the ground extends the range by it front and rear,
+// REQ-MB-003), the last balise and the measured speed. No valid position, or a front off the
+// block table: NO_POSITION.
+// @implements REQ-MB-001
+messages::Message OnboardUnit::Report(const ra::OdometryOutput& o) const noexcept {
+  const std::int64_t correction = ra::ReportCorrectionMm(o);
+  // The envelope's rear end of the front would report the train behind where it may be.
+  const std::int64_t front = RAILPROOF_FAULT(FAULT_UNIT_REPORT_UNSAFE_END) ? o.front_mm - correction : o.front_mm;
+  if (!o.position_valid || front < 0 || front > blocks_[blocks_.Size() - 1]) {
+    return messages::NoPosition{};
+  }
+  std::size_t block = 0;
+  if (front > 0) {
+    const auto it = std::upper_bound(blocks_.begin(), blocks_.end(), front - 1);
+    block = static_cast<std::size_t>(it - blocks_.begin()) - 1;
+  }
+  return messages::PositionReport{train_id_,
+                                  static_cast<std::uint32_t>(block),
+                                  front - blocks_[block],
+                                  length_mm_,
+                                  correction,
+                                  o.last_balise_mm,
+                                  o.speed_mm_s,
+                                  messages::Direction::kNominal};
+}
+
+// One telegram (REQ-TG-008): the report first, then the crossing messages of the last
+// crossing cycle that fit, continuing where the previous telegram stopped (REQ-LC-002,
+// REQ-LC-004: every message repeated until its state changes).
+void OnboardUnit::Send(const ra::OdometryOutput& o) noexcept {
+  messages::Bundle bundle;
+  (void)bundle.Add(Report(o));
+  const lc::onboard::ProtectionOutput& p = crossings_->Output();
+  const std::size_t pending = p.request_count + p.withdrawal_count;
+  std::size_t added = 0;
+  for (std::size_t k = 0; k < pending; ++k) {
+    const std::size_t i = (pending_cursor_ + k) % pending;
+    const messages::CrossingRequest r{train_id_, i < p.request_count ? p.requests[i] : p.withdrawals[i - p.request_count]};
+    const messages::Message m = i < p.request_count ? messages::Message{r} : messages::Message{messages::CrossingWithdrawal{r}};
+    if (!bundle.Add(m)) {
+      break;
+    }
+    if (messages::BundleSize(bundle.View()) > messages::kPayloadCapacity) {
+      --bundle.size;
+      break;
+    }
+    ++added;
+  }
+  pending_cursor_ = pending == 0 ? 0 : (pending_cursor_ + added) % pending;
+  messages::Encoded e = messages::EncodeBundle(bundle.View());
+  if (!e.Ok()) {
+    // a report the codec refuses (a value out of its range) goes as NO_POSITION, alone
+    out_.encode_error = e.error;
+    e = messages::Encode(messages::NoPosition{});
+    added = 0;
+  }
+  const auto sent = endpoint_.Cycle(static_cast<std::uint32_t>(out_.now_ms), e.payload.View(), out_.frame);
+  out_.send_status = sent.status;
+  out_.sent = sent.status == tg::SendStatus::kSent;
+  out_.crossing_messages_sent = out_.sent ? added : 0;
+}
+
+void OnboardUnit::AddEvent(const RxEvent& e) noexcept {
+  if (out_.event_count < out_.events.size()) {
+    out_.events[out_.event_count++] = e;
+  }
+}
+
+// The frames of the cycle through the telegram layer (REQ-TG-001..012 in tg::Endpoint) and
+// the codec; each message to its module.
+void OnboardUnit::Receive(const OnboardInputs& in) noexcept {
+  report_count_ = 0;
+  ack_count_ = 0;
+  const std::size_t n = std::min(in.frames.size(), kMaxFramesPerCycle);
+  for (std::size_t f = 0; f < n; ++f) {
+    RxEvent event;
+    event.frame = f;
+    const auto r = endpoint_.Receive(static_cast<std::uint32_t>(in.now_ms), in.frames[f], rx_payload_);
+    if (r.reason != tg::RejectReason::kNone) {
+      event.status = RxStatus::kFrameRejected;
+      event.reject = r.reason;
+      AddEvent(event);
+      continue;
+    }
+    const std::size_t len = std::min<std::size_t>(r.header.payload_len, rx_payload_.size());
+    const messages::DecodedBundle d = messages::DecodeBundle(std::span<const std::uint8_t>(rx_payload_).first(len));
+    if (!d.Ok()) {
+      event.status = RxStatus::kUndecodable;
+      event.decode = d.error;
+      event.field = d.field;
+      event.entry = d.entry;
+      AddEvent(event);
+      continue;
+    }
+    for (std::size_t k = 0; k < d.bundle.size; ++k) {
+      event.entry = k;
+      OnMessage(d.bundle.messages[k], event);
+    }
+  }
+  if (in.frames.size() > n) {
+    RxEvent dropped;
+    dropped.status = RxStatus::kFramesDropped;
+    dropped.entry = in.frames.size() - n;
+    AddEvent(dropped);
+  }
+}
+
+void OnboardUnit::OnMessage(const messages::Message& m, RxEvent event) noexcept {
+  event.type = messages::TypeOf(m);
+  if (const auto* t = std::get_if<messages::StopLimitTelegram>(&m)) {
+    if (t->train_id != train_id_) {
+      event.status = RxStatus::kOtherTrain;
+    } else {
+      // REQ-MB-009 (AuthorityReceiver), then the restrictions of the accepted telegram
+      // (REQ-MB-015, SpeedRestrictionStore)
+      event.verdict = authority_.Receive(t->limit_mm, t->issue_time_ms, out_.now_ms);
+      event.status = event.verdict == mb::onboard::Verdict::kAccept ? RxStatus::kAccepted : RxStatus::kStopLimitRefused;
+      if (event.verdict == mb::onboard::Verdict::kAccept) {
+        obstruction_ = t->kind;
+        const std::size_t count = std::min<std::size_t>(t->restriction_count, t->restrictions.size());
+        (void)restrictions_.Update(std::span<const messages::SpeedRestriction>(t->restrictions.data(), count),
+                                   last_store_front_mm_, length_mm_);
+      }
+    }
+  } else if (std::holds_alternative<messages::KeepAlive>(m)) {
+    event.status = RxStatus::kAccepted;  // REQ-MB-024: the link is kept, no limit
+  } else if (const auto* c = std::get_if<messages::CrossingReport>(&m)) {
+    event.status = report_count_ < reports_.size() ? RxStatus::kAccepted : RxStatus::kMessageDropped;
+    if (report_count_ < reports_.size()) {
+      reports_[report_count_++] = *c;
+    }
+  } else if (const auto* a = std::get_if<messages::WithdrawalAck>(&m)) {
+    if (a->train_id != train_id_) {
+      event.status = RxStatus::kOtherTrain;
+    } else {
+      event.status = ack_count_ < acks_.size() ? RxStatus::kAccepted : RxStatus::kMessageDropped;
+      if (ack_count_ < acks_.size()) {
+        acks_[ack_count_++] = *a;
+      }
+    }
+  } else {
+    event.status = RxStatus::kUnexpectedType;
+  }
+  AddEvent(event);
+}
+
+// The profile of the patterns and of the crossing arrival times: rebuilt when the held
+// restrictions changed.
+void OnboardUnit::UpdateProfile() noexcept {
+  const auto held = restrictions_.Held();
+  const bool same = !profile_stale_ && held.size() == merged_held_count_ &&
+                    std::equal(held.begin(), held.end(), merged_held_.begin(), [](const auto& a, const auto& b) {
+                      return a.id == b.id && a.begin_mm == b.begin_mm && a.end_mm == b.end_mm &&
+                             a.speed_mm_s == b.speed_mm_s;
+                    });
+  if (same) {
+    return;
+  }
+  std::copy(held.begin(), held.end(), merged_held_.begin());
+  merged_held_count_ = held.size();
+  profile_stale_ = false;
+  (void)profile_.Resize(profile_.Capacity());
+  const MergeResult m = MergeRestrictions(line_limits_.Span(), held, profile_.Span(), scratch_.Span());
+  (void)profile_.Resize(m.ok ? m.count : 0);
+  out_.profile = patterns_->SetProfile(gradients_.Span(), profile_.Span()).verdict;
+}
+
+// Crossing protection (REQ-LC-001..005 in lc::onboard::CrossingProtection) with the envelope
+// and the supervised speed (an upper bound of the speed, as the protection asks); standing at
+// a scheduled stop it is the dwell rule's standstill. Without a valid position the cycle is not
+// run: the protection keeps its requests and its limit (its refused-cycle rule).
+void OnboardUnit::Protect(const OnboardInputs& in, const ra::OdometryOutput& o) noexcept {
+  if (!o.position_valid) {
+    out_.crossing_error = lc::onboard::ProtectionError::kNone;
+    return;
+  }
+  lc::onboard::ProtectionInput pi;
+  pi.now_ms = in.now_ms;
+  pi.front_mm = o.front_mm;
+  pi.front_error_mm = o.front_error_mm;
+  pi.rear_error_mm = o.rear_error_mm;
+  pi.dwell = in.dwell_departure_ms.has_value() && o.standstill;
+  pi.departure_ms = in.dwell_departure_ms.value_or(0);
+  pi.speed_mm_s = pi.dwell ? 0 : patterns_->SupervisedSpeed(o.speed_mm_s, o.standstill);
+  pi.restrictions = profile_.Span();
+  pi.reports = std::span<const messages::CrossingReport>(reports_.data(), report_count_);
+  pi.acks = std::span<const messages::WithdrawalAck>(acks_.data(), ack_count_);
+  out_.crossing_error = crossings_->Cycle(pi);
+}
+
+// Braking supervision (REQ-BR-001..007 in br::PatternCalculator and br::Supervisor) against the
+// nearer of the usable movement authority (REQ-MB-009) and the crossing protection limit
+// (REQ-LC-003); no usable authority: the standstill supervision (REQ-BR-012).
+void OnboardUnit::Supervise(const ra::OdometryOutput& o, const br::DriverInputs& driver) noexcept {
+  br::PositionEstimate pe = ra::ToPositionEstimate(o);
+  if (RAILPROOF_FAULT(FAULT_UNIT_REAR_FOR_FRONT)) {
+    // the undercounting bound of the front where the safe front belongs
+    pe.front_mm = o.front_mm - o.rear_error_mm;
+    pe.front_error_mm = 0;
+  }
+  Indications& ind = out_.indications;
+  ind = Indications{};
+  std::optional<std::int64_t> limit;
+  if (authority_.Usable(out_.now_ms) && authority_.Limit()) {
+    limit = authority_.Limit();
+    ind.limit_kind = LimitKind::kMovementAuthority;
+    ind.obstruction = obstruction_;
+    const auto& p = crossings_->Output();
+    if (p.stop_limit_mm && *p.stop_limit_mm < *limit && !RAILPROOF_FAULT(FAULT_UNIT_CROSSING_LIMIT_IGNORED)) {
+      limit = p.stop_limit_mm;
+      ind.limit_kind = LimitKind::kCrossingProtection;
+      ind.obstruction = messages::Obstruction::kNone;
+      ind.crossing_id = p.limiting_crossing_id;
+    }
+  }
+  supervised_limit_mm_ = limit;
+  evaluation_ = patterns_->Evaluate(pe, limit);
+  out_.evaluation = evaluation_.status;
+  br::DriverInputs d = driver;
+  d.standstill = o.standstill;
+  decision_ = supervisor_.Step(evaluation_.speeds, d);
+  ind.permitted_speed_mm_s = std::max<std::int64_t>(0, evaluation_.speeds.v_7n);
+  ind.warning = decision_.pattern_approaching;
+  ind.limit_mm = limit;
+  ind.target_distance_mm = limit ? *limit - (pe.front_mm + pe.front_error_mm) : 0;
+}
+
+void OnboardUnit::Demand(const ra::OdometryOutput& o) noexcept {
+  out_.level = decision_.level;
+  const bool eb = decision_.level == br::BrakeLevel::kEmergency;
+  if (out_.link != tg::LinkState::kUp) {
+    out_.reason = BrakeReason::kRadioLink;
+  } else if (o.stop_demand) {
+    out_.reason = BrakeReason::kOdometryStop;
+  } else if (eb && evaluation_.status != br::EvalStatus::kOk) {
+    out_.reason = BrakeReason::kSupervisionInput;
+  } else if (eb && !supervised_limit_mm_) {
+    out_.reason = BrakeReason::kNoUsableLimit;
+  } else if (eb) {
+    out_.reason = BrakeReason::kEmergencyPattern;
+  } else if (decision_.level != br::BrakeLevel::kNone) {
+    out_.reason = BrakeReason::kServicePattern;
+  } else {
+    out_.reason = BrakeReason::kNone;
+  }
+  out_.brake = out_.reason == BrakeReason::kNone             ? BrakeDemand::kNone
+               : out_.reason == BrakeReason::kServicePattern ? BrakeDemand::kService
+                                                             : BrakeDemand::kEmergency;
+}
+
+}  // namespace railproof::units
