@@ -49,7 +49,7 @@ OnboardCreateResult OnboardUnit::Create(const OnboardConfig& config) noexcept {
 
 ConfigCheck OnboardUnit::Init(const OnboardConfig& c) noexcept {
   if (!MultipleOfCycle(c.supervision.cycle_ms) || !MultipleOfCycle(c.radio_period_ms) || c.radio_offset_ms < 0 ||
-      c.radio_offset_ms % kOnboardCycleMs != 0 || c.radio_offset_ms >= c.radio_period_ms) {
+      c.radio_offset_ms % kOnboardCycleMs != 0 || c.radio_offset_ms > c.radio_period_ms) {
     return Fail(ConfigError::kPeriods);
   }
   const auto blocks = c.line.blocks_mm;
@@ -272,6 +272,7 @@ void OnboardUnit::Send(const ra::OdometryOutput& o) noexcept {
   }
   const auto sent = endpoint_.Cycle(static_cast<std::uint32_t>(out_.now_ms), e.payload.View(), out_.frame);
   out_.send_status = sent.status;
+  out_.send_link = sent.link;
   out_.sent = sent.status == tg::SendStatus::kSent;
   out_.crossing_messages_sent = out_.sent ? added : 0;
 }
@@ -292,6 +293,8 @@ void OnboardUnit::Receive(const OnboardInputs& in) noexcept {
     RxEvent event;
     event.frame = f;
     const auto r = endpoint_.Receive(static_cast<std::uint32_t>(in.now_ms), in.frames[f], rx_payload_);
+    event.gap = r.gap;
+    event.link = r.link;
     if (r.reason != tg::RejectReason::kNone) {
       event.status = RxStatus::kFrameRejected;
       event.reject = r.reason;

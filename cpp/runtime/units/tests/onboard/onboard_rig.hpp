@@ -127,7 +127,7 @@ inline messages::StopLimitTelegram StopLimit(std::int64_t limit_mm, std::int64_t
 // by the peer (Heard).
 class Rig {
  public:
-  explicit Rig(const OnboardConfig& c) : peer_(c.radio) {
+  explicit Rig(const OnboardConfig& c, std::int64_t t0_ms = 1'000) : peer_(c.radio), stream_(0.0, t0_ms) {
     auto r = OnboardUnit::Create(c);
     EXPECT_EQ(r.check.error, ConfigError::kNone) << ToString(r.check.error);
     unit_.emplace(std::move(*r.unit));
@@ -136,6 +136,12 @@ class Rig {
     OnboardInputs in;
     in.sensors = stream_.Next(k, imu);
     in.now_ms = in.sensors.time_ms;
+    if (imu_fault) {
+      in.sensors.imu_count = static_cast<std::uint8_t>(ra::kImuSamplesPerCycle - 1);
+    }
+    if (tg_fault) {
+      in.sensors.tg.last_edge_us = in.sensors.tg.time_us + 1;  // an edge after the sample
+    }
     in.balise_id = std::exchange(balise_, std::nullopt);
     in.driver = driver_;
     in.dwell_departure_ms = dwell_departure_ms;
@@ -189,6 +195,8 @@ class Rig {
   ra::test::Stream& Sensors() { return stream_; }
   [[nodiscard]] const std::vector<messages::Message>& Heard() const { return heard_; }
   std::optional<std::int64_t> dwell_departure_ms;
+  bool imu_fault = false;
+  bool tg_fault = false;
 
  private:
   std::optional<OnboardUnit> unit_;

@@ -30,7 +30,7 @@ TEST(OnboardUnitConfig, RefusesEachBadPartWithItsReason) {
     c.radio_period_ms = 150;
     EXPECT_EQ(CreateError(c), ConfigError::kPeriods);
     c = Config(line);
-    c.radio_offset_ms = c.radio_period_ms;
+    c.radio_offset_ms = c.radio_period_ms + kOnboardCycleMs;
     EXPECT_EQ(CreateError(c), ConfigError::kPeriods);
   }
   {
@@ -251,15 +251,16 @@ TEST(OnboardUnit, UndecodablePayloadAndTooManyFramesAreReported) {
   ASSERT_EQ(ground.Init(g, tg::LinkKey(kKey)), tg::ConfigError::kNone);
   const std::array<std::uint8_t, 1> junk{0xEE};
   ground.Cycle(static_cast<std::uint32_t>(rig.Now()), junk, f);
-  for (int k = 0; k < 6; ++k) {
+  for (std::size_t k = 0; k < kMaxFramesPerCycle + 2; ++k) {
     rig.Deliver({f.View().begin(), f.View().end()});
   }
   const OnboardOutputs& out = rig.Step();
   const auto ev = out.Events();
-  ASSERT_EQ(ev.size(), 5U);
+  ASSERT_EQ(ev.size(), kMaxFramesPerCycle + 1);
   EXPECT_EQ(ev[0].status, RxStatus::kFrameRejected);  // no echo of the train's telegram yet
-  EXPECT_EQ(ev[4].status, RxStatus::kFramesDropped);
-  EXPECT_EQ(ev[4].entry, 2U);
+  EXPECT_EQ(ev[0].reject, tg::RejectReason::kNoEcho);
+  EXPECT_EQ(ev[kMaxFramesPerCycle].status, RxStatus::kFramesDropped);
+  EXPECT_EQ(ev[kMaxFramesPerCycle].entry, 2U);
   // through the rig's ground, which has heard the train: the codec's reason
   rig.StepToSend();
   rig.Deliver(rig.Ground().SendBytes(rig.Now(), junk));

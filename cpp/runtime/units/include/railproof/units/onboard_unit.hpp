@@ -51,7 +51,7 @@ namespace railproof::units {
 // The unit's cycle: the odometry's (D1 §3).
 inline constexpr std::int64_t kOnboardCycleMs = params::ra::cycle_ms;
 // Frames read in one cycle; more are dropped (RxStatus::kFramesDropped).
-inline constexpr std::size_t kMaxFramesPerCycle = 4;
+inline constexpr std::size_t kMaxFramesPerCycle = 8;
 // Events reported per cycle: one per message of every frame read, and the dropped frames.
 inline constexpr std::size_t kMaxRxEvents = kMaxFramesPerCycle * messages::kBundleMax + 1;
 
@@ -90,6 +90,7 @@ struct OnboardConfig {
   std::optional<tg::LinkKey> link_key;
   std::int64_t radio_period_ms = params::tg::train_cycle_ms;
   std::int64_t radio_offset_ms = 0;            // first telegram this long after the first cycle
+                                               // (0 .. radio_period_ms)
 };
 
 enum class ConfigError : std::uint8_t {
@@ -197,6 +198,8 @@ struct RxEvent {
   RxStatus status = RxStatus::kAccepted;
   std::size_t frame = 0;                                 // index in OnboardInputs::frames
   tg::RejectReason reject = tg::RejectReason::kNone;
+  std::uint32_t gap = 0;                                 // telegrams lost before this frame
+  tg::LinkState link = tg::LinkState::kNone;             // after this frame
   messages::DecodeError decode = messages::DecodeError::kNone;
   messages::Field field = messages::Field::kNone;
   std::size_t entry = 0;                                 // message index in the bundle
@@ -224,6 +227,7 @@ struct OnboardOutputs {
   // the radio
   tg::LinkState link = tg::LinkState::kNone;
   bool sent = false;                             // `frame` holds this cycle's telegram
+  tg::LinkState send_link = tg::LinkState::kNone;  // the link supervision at the last telegram
   tg::EncodedFrame frame{};
   tg::SendStatus send_status = tg::SendStatus::kSent;
   messages::EncodeError encode_error = messages::EncodeError::kNone;  // the bundle (report sent alone)
