@@ -63,7 +63,8 @@ void WaysideUnit::ChannelStep() noexcept {
       --cell_load_[s.first_cell];
       ++s.first_cell;
     }
-    while (s.last_cell < handover_mm_.Size() && handover_mm_[s.last_cell] - ext->end_mm <= secure_ahead_mm_) {
+    while (secure_ahead_mm_ && s.last_cell < handover_mm_.Size() &&
+           handover_mm_[s.last_cell] - ext->end_mm <= *secure_ahead_mm_) {
       if (cell_load_[s.last_cell + 1] >= per_station_) {
         Event(InputStatus::kBaseStationFull, s.train_id);
         break;
@@ -138,8 +139,8 @@ void WaysideUnit::TakeAnswers(std::span<const HandoverResponse> answers) noexcep
 // nearest obstruction (every other one is behind its rear).
 // @implements REQ-MB-023
 void WaysideUnit::BoundaryAcceptance() noexcept {
-  if (!boundary_mm_) {
-    return;
+  if (!zone_begin_mm_) {
+    return;  // no next unit: the boundary is accepted by command (AcceptAtBoundary)
   }
   const Slot* foremost = nullptr;
   for (const Slot& s : slots_) {

@@ -55,7 +55,7 @@ ConfigError WaysideUnit::Init(const WaysideConfig& config, CreateResult& result)
     return ConfigError::kLineInvalid;
   }
   ground_ = std::move(created.ground);
-  if (config.secure_ahead_mm < 0 || config.secure_ahead_mm > mb::wayside::kMaxLineMm) {
+  if (config.secure_ahead_mm && (*config.secure_ahead_mm < 0 || *config.secure_ahead_mm > mb::wayside::kMaxLineMm)) {
     return ConfigError::kSecureAheadInvalid;
   }
   if (config.crossings.size() > lc::kMaxCrossings) {

@@ -63,7 +63,7 @@ TEST(WaysideUnitConfig, RefusesEachInvalidPartWithItsReason) {
   c.trains_per_base_station = 0;
   EXPECT_EQ(WaysideUnit::Create(c).error, ConfigError::kBaseStationCapacityInvalid);
   c = BaseConfig(line);
-  c.secure_ahead_mm = -1;
+  c.secure_ahead_mm = -1;  // NOLINT
   EXPECT_EQ(WaysideUnit::Create(c).error, ConfigError::kSecureAheadInvalid);
   c = BaseConfig(line);
   const std::vector<lc::CrossingData> twice{{1, 100, 200, 1000}, {1, 300, 400, 1000}};

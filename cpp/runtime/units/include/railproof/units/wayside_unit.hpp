@@ -86,8 +86,9 @@ struct WaysideConfig {
   mb::wayside::LineConfig line{};
   mb::wayside::Capacity capacity{};
   std::size_t trains_per_base_station = kTrainsPerBaseStation;
-  // a handover point is secured for a train when its extended front end is this close (mm)
-  std::int64_t secure_ahead_mm = 0;
+  // a handover point is secured for a train when its extended front end is this close (mm);
+  // none: only by command (SecureHandover)
+  std::optional<std::int64_t> secure_ahead_mm;
   // crossings of the line (ids unique), each with one controller of these parameters
   std::span<const lc::CrossingData> crossings;
   lc::wayside::ControllerConfig controller = lc::wayside::DefaultControllerConfig(0);
@@ -358,6 +359,11 @@ class WaysideUnit {
   mb::wayside::CommandStatus ClearUnequippedOccupancy(std::uint32_t id) noexcept {
     return ground_->ClearUnequippedOccupancy(id);
   }
+  mb::wayside::CommandStatus SecureHandover(std::uint32_t train_id, std::uint32_t handover_id) noexcept {
+    return ground_->SecureHandover(train_id, handover_id);
+  }
+  // only without a next unit (handover_zone_begin_mm): else the unit decides
+  mb::wayside::CommandStatus AcceptAtBoundary(bool accepted) noexcept { return ground_->AcceptAtBoundary(accepted); }
   // Starts a GNSS-time departure over the crossings `crossing_ids` (all held by the unit).
   lc::wayside::SchedulerError StartDeparture(const lc::wayside::Departure& departure,
                                              std::span<const std::uint32_t> crossing_ids, std::int64_t now_ms) noexcept;
@@ -442,7 +448,7 @@ class WaysideUnit {
   KeyProvider keys_ = nullptr;
   const void* key_context_ = nullptr;
   std::size_t per_station_ = 0;
-  std::int64_t secure_ahead_mm_ = 0;
+  std::optional<std::int64_t> secure_ahead_mm_;
   std::int64_t origin_mm_ = 0;
   std::optional<std::int64_t> zone_begin_mm_;
   std::optional<std::int64_t> boundary_mm_;
