@@ -38,7 +38,7 @@ namespace {
 using json = nlohmann::json;
 namespace rc = railproof::conformance;
 
-constexpr const char* kVectors = RAILPROOF_ONBOARD_VECTORS;
+constexpr const char* kVectors = RAILPROOF_UNITS_VECTORS;
 
 // Every vector of the files <prefix>*.jsonl with its file's header; the test fails on a
 // missing, empty or unreadable set.

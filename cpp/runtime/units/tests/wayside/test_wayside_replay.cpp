@@ -201,7 +201,7 @@ TEST(WaysideReplay, MovingBlockVectorsThroughTheUnitsBytes) {
   std::vector<rc::JsonVector> vectors;
   std::size_t files = 0;
   const std::string error = rc::ReadVectorDirectory(
-      RAILPROOF_WAYSIDE_VECTORS, "mb", rc::MbVectorKeys(),
+      RAILPROOF_UNITS_VECTORS, "mb", rc::MbVectorKeys(),
       [&](const std::string& file, const json& h) {
         headers[file] = h;
         return std::string();
