@@ -12,6 +12,20 @@ double ResistanceDecel(const Resistance& r, double speed_mps) {
   return kGravity * (r.a0 + r.a1 * v_kmh + r.a2 * v_kmh * v_kmh) / 1000.0;
 }
 
+Resistance ConsistResistance(const Consist& c) {
+  const double w = c.motor_mass_t + c.trailer_mass_t;
+  return Resistance{(1.65 * c.motor_mass_t + 0.78 * c.trailer_mass_t) / w,
+                    (0.0247 * c.motor_mass_t + 0.0028 * c.trailer_mass_t) / w,
+                    (0.028 + 0.0078 * (c.cars - 1)) / w};
+}
+
+double MaxTraction(const TrainPerformance& perf, double speed_mps) {
+  if (perf.constant_power_from_mps > 0.0 && speed_mps > perf.constant_power_from_mps) {
+    return perf.accel_mps2 * perf.constant_power_from_mps / speed_mps;
+  }
+  return perf.accel_mps2;
+}
+
 double GradeDecel(double gradient_permille, double gravity) { return gravity * gradient_permille / 1000.0; }
 
 double NetAcceleration(const TrainPerformance& perf, const Control& control, double speed_mps,
@@ -20,7 +34,7 @@ double NetAcceleration(const TrainPerformance& perf, const Control& control, dou
   if (control.emergency) {
     applied = -perf.emergency_decel_mps2;
   } else {
-    const double traction = speed_mps < perf.max_speed_mps ? std::clamp(control.traction_mps2, 0.0, perf.accel_mps2) : 0.0;
+    const double traction = speed_mps < perf.max_speed_mps ? std::clamp(control.traction_mps2, 0.0, MaxTraction(perf, speed_mps)) : 0.0;
     applied = traction - std::clamp(control.brake_mps2, 0.0, perf.service_decel_mps2);
   }
   // At standstill the resistance does not push the train backwards (static friction).

@@ -3,10 +3,12 @@
 // Forces per unit mass (accelerations, + forward; any length unit with seconds, the unit of
 // the gravity given):
 //   a = applied - r(v) - g i / 1000
-//   applied   traction in [0, accel_max] while v < max speed (constant maximum, no power
-//             limit), or minus a braking deceleration (service, or the emergency brake alone),
+//   applied   traction in [0, MaxTraction(v)] while v < max speed (constant accel_max, or with
+//             constant_power_from_mps > 0 falling as accel_max v_b / v above that speed v_b),
+//             or minus a braking deceleration (service, or the emergency brake alone),
 //   r(v)      running resistance a0 + a1 v + a2 v^2 in N/kN (= per mille of the train's
-//             weight), v in km/h (Davis form; SI only),
+//             weight), v in km/h (Davis form; SI only); an electric multiple unit's from its
+//             consist by ConsistResistance,
 //   g i/1000  gravity on a gradient of i per mille (+ rising): GradeDecel.
 // Motion under a constant acceleration is exact: Advance over a time, SpeedAfter and TimeOver
 // over a distance, TimeToCover a distance; a braking or coasting train stops at v = 0 and does
@@ -32,7 +34,11 @@
 //                             at the service deceleration ahead of lower limits and the stop
 //                             (SpeedAfter), times by TimeOver, positions in time by Advance and
 //                             TimeToCover; gradients and resistance not modelled (its
-//                             documented model); mm.
+//                             documented model); mm;
+//   headway study (fc)        fixed time steps (Advance of NetAcceleration, D2 §3) for the leader
+//                             and the follower, with the D2 consist's resistance
+//                             (ConsistResistance) and a constant-power traction region; mean
+//                             gradient under the train; SI units, gravity kGravity.
 // Not this model: the Box2D wheel-rail simulator (ra) is multi-body creep physics (car body,
 // bogies, wheelsets, slip-dependent adhesion per wheelset): slip and slide, its subject, do
 // not exist for a point mass.
@@ -64,6 +70,20 @@ struct Resistance {
   double a2 = 0.0003;
 };
 
+// An electric multiple unit's consist: car count and the total masses of its motor cars and
+// its trailers (t).
+struct Consist {
+  int cars = 0;
+  double motor_mass_t = 0.0;
+  double trailer_mass_t = 0.0;
+};
+
+// Running resistance of an electric multiple unit from its consist, the usual handbook form in
+// kgf (W in t, v in km/h): (1.65 + 0.0247 v) W_motor + (0.78 + 0.0028 v) W_trailer +
+// (0.028 + 0.0078 (cars - 1)) v^2, per unit weight: since 1 kgf/t = 1 N/kN it is a Davis form
+// in N/kN. The coefficients are ASM-032's (the handbook D2 cites is not available).
+Resistance ConsistResistance(const Consist& consist);
+
 struct TrainPerformance {
   double length_m = 0.0;
   double max_speed_mps = 0.0;
@@ -71,7 +91,14 @@ struct TrainPerformance {
   double service_decel_mps2 = 0.0;
   double emergency_decel_mps2 = 0.0;
   Resistance resistance;
+  // Above this speed the traction falls as accel_mps2 * v_b / v (constant power); 0: the
+  // constant maximum up to the maximum speed.
+  double constant_power_from_mps = 0.0;
 };
+
+// The largest traction acceleration at a speed (accel_mps2, or lower in the constant-power
+// region).
+double MaxTraction(const TrainPerformance& perf, double speed_mps);
 
 // Commands for one step.
 struct Control {
