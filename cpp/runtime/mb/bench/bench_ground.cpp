@@ -16,7 +16,7 @@
 
 #include "railproof/generated/mb_params.hpp"
 #include "railproof/mb/wayside/ground.hpp"
-#include "../tests/line_data.hpp"
+#include "bench_line.hpp"
 
 namespace {
 
@@ -24,35 +24,8 @@ using namespace railproof::core;  // NOLINT(google-build-using-namespace)
 using namespace railproof::mb::wayside;  // NOLINT(google-build-using-namespace)
 using namespace railproof::messages;  // NOLINT(google-build-using-namespace)
 
-constexpr std::int64_t kBlocks = 10'000;
-constexpr std::int64_t kBlockMm = 50'000;
-constexpr std::int64_t kLineMm = kBlocks * kBlockMm;  // 500 km
-
-struct BenchLine : railproof::mb::wayside::test::LineData {
-  BenchLine() {
-    base.length_mm = kLineMm;
-    boundary = kLineMm - 1'000'000;
-    for (std::int64_t b = 0; b <= kBlocks; ++b) {
-      blocks.push_back(b * kBlockMm);
-    }
-    for (std::int64_t km = 5; km < 500; km += 5) {  // a station every 5 km
-      fixed.push_back(Section{km * 1'000'000, km * 1'000'000 + 200'000});
-    }
-    for (std::int64_t km = 7; km < 500; km += 10) {  // a junction every 10 km
-      const auto p = static_cast<std::uint32_t>(points.size());
-      const std::int64_t at = km * 1'000'000;
-      points.push_back(PointsConfig{p, Section{at, at + kBlockMm}});
-      routes.push_back(RouteConfig{2 * p + 1, at, at + 2 * kBlockMm, p, false, true});
-      routes.push_back(RouteConfig{2 * p + 2, at, at + 2 * kBlockMm, p, true, false});
-    }
-    for (std::int64_t km = 2; km < 500; km += 2) {  // a handover every 2 km
-      handovers.push_back(HandoverConfig{static_cast<std::uint32_t>(km), km * 1'000'000 + 1'000});
-    }
-    for (std::int64_t km = 3; km < 500; km += 25) {  // a few no-stop sections
-      no_stop.push_back(Section{km * 1'000'000 + 500'000, km * 1'000'000 + 600'000});
-    }
-  }
-};
+using railproof::mb::wayside::bench::BenchLine;
+using railproof::mb::wayside::bench::kBlocks;
 
 struct Scenario {
   BenchLine line;

@@ -28,7 +28,7 @@ bool CopyInto(std::span<const T> from, core::FixedVector<T>& to) noexcept {
   return true;
 }
 
-ConfigCheck Fail(ConfigError e, std::size_t entry = 0) noexcept {
+ConfigCheck Fail(OnboardConfigError e, std::size_t entry = 0) noexcept {
   ConfigCheck c;
   c.error = e;
   c.entry = entry;
@@ -41,7 +41,7 @@ OnboardCreateResult OnboardUnit::Create(const OnboardConfig& config) noexcept {
   OnboardCreateResult r;
   r.unit.emplace(Token{});
   r.check = r.unit->Init(config);
-  if (r.check.error != ConfigError::kNone) {
+  if (r.check.error != OnboardConfigError::kNone) {
     r.unit.reset();
   }
   return r;
@@ -50,15 +50,15 @@ OnboardCreateResult OnboardUnit::Create(const OnboardConfig& config) noexcept {
 ConfigCheck OnboardUnit::Init(const OnboardConfig& c) noexcept {
   if (!MultipleOfCycle(c.supervision.cycle_ms) || !MultipleOfCycle(c.radio_period_ms) || c.radio_offset_ms < 0 ||
       c.radio_offset_ms % kOnboardCycleMs != 0 || c.radio_offset_ms > c.radio_period_ms) {
-    return Fail(ConfigError::kPeriods);
+    return Fail(OnboardConfigError::kPeriods);
   }
   const auto blocks = c.line.blocks_mm;
   if (blocks.size() < 2 || blocks[0] != 0) {
-    return Fail(ConfigError::kBlocks);
+    return Fail(OnboardConfigError::kBlocks);
   }
   for (std::size_t i = 1; i < blocks.size(); ++i) {
     if (blocks[i] <= blocks[i - 1] || blocks[i] > core::kMaxPositionMm) {
-      return Fail(ConfigError::kBlocks, i);
+      return Fail(OnboardConfigError::kBlocks, i);
     }
   }
   const auto balises = c.line.balises;
@@ -67,12 +67,12 @@ ConfigCheck OnboardUnit::Init(const OnboardConfig& c) noexcept {
     const bool twice = std::any_of(balises.begin(), balises.begin() + static_cast<std::ptrdiff_t>(i),
                                    [&](const BaliseEntry& b) { return b.id == balises[i].id; });
     if (!on_line || twice) {
-      return Fail(ConfigError::kBalises, i);
+      return Fail(OnboardConfigError::kBalises, i);
     }
   }
   if (!CopyInto(blocks, blocks_) || !CopyInto(balises, balises_) || !CopyInto(c.line.gradients, gradients_) ||
       !CopyInto(c.line.speed_limits, line_limits_) || !CopyInto(c.line.odometry_sections, sections_)) {
-    return Fail(ConfigError::kOutOfMemory);  // GCOVR_EXCL_LINE defensive
+    return Fail(OnboardConfigError::kOutOfMemory);  // GCOVR_EXCL_LINE defensive
   }
   train_id_ = c.train_id;
   length_mm_ = c.train.length_mm;
@@ -86,7 +86,7 @@ ConfigCheck OnboardUnit::Init(const OnboardConfig& c) noexcept {
   oc.section_count = static_cast<int>(c.line.odometry_sections.size());
   oc.initial_front_mm = c.initial_front_mm;
   if (const ra::ConfigError e = ra::Odometry::Create(oc, odometry_); e != ra::ConfigError::kNone) {
-    ConfigCheck check = Fail(ConfigError::kOdometry);
+    ConfigCheck check = Fail(OnboardConfigError::kOdometry);
     check.odometry = e;
     return check;
   }
@@ -97,20 +97,20 @@ ConfigCheck OnboardUnit::Init(const OnboardConfig& c) noexcept {
                                          std::size_t{1}});
   auto created = br::PatternCalculator::Create(c.train, c.supervision, std::min(capacity, core::kMaxProfileCapacity));
   if (created.error != br::CreateError::kNone) {
-    ConfigCheck check = Fail(ConfigError::kTrainData);
+    ConfigCheck check = Fail(OnboardConfigError::kTrainData);
     check.braking = created.error;
     return check;
   }
   patterns_.emplace(std::move(*created.calculator));
   if (const br::ProfileResult p = patterns_->SetProfile(gradients_.Span(), line_limits_.Span());
       p.verdict != br::ProfileVerdict::kAccept) {
-    ConfigCheck check = Fail(ConfigError::kLineProfile, p.entry);
+    ConfigCheck check = Fail(OnboardConfigError::kLineProfile, p.entry);
     check.profile = p;
     return check;
   }
   const std::size_t merged = MergeCapacity(c.line.speed_limits.size(), mb::onboard::kStoredRestrictionsMax);
   if (!profile_.Allocate(merged) || !scratch_.Allocate(merged) || !scratch_.Resize(merged)) {
-    return Fail(ConfigError::kOutOfMemory);  // GCOVR_EXCL_LINE defensive
+    return Fail(OnboardConfigError::kOutOfMemory);  // GCOVR_EXCL_LINE defensive
   }
 
   lc::onboard::ProtectionConfig pc = c.crossing;
@@ -124,17 +124,17 @@ ConfigCheck OnboardUnit::Init(const OnboardConfig& c) noexcept {
     pe = crossings_->LoadCrossings(c.line.crossings);
   }
   if (pe != lc::onboard::ProtectionError::kNone) {
-    ConfigCheck check = Fail(ConfigError::kCrossings);
+    ConfigCheck check = Fail(OnboardConfigError::kCrossings);
     check.crossings = pe;
     return check;
   }
 
   authority_ = mb::onboard::AuthorityReceiver(c.authority);
   if (c.radio.role != tg::Role::kTrain || !c.link_key) {
-    return Fail(ConfigError::kRadio);
+    return Fail(OnboardConfigError::kRadio);
   }
   if (const tg::ConfigError e = endpoint_.Init(c.radio, *c.link_key); e != tg::ConfigError::kNone) {
-    ConfigCheck check = Fail(ConfigError::kRadio);
+    ConfigCheck check = Fail(OnboardConfigError::kRadio);
     check.radio = e;
     return check;
   }

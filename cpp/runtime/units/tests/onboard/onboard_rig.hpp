@@ -129,7 +129,7 @@ class Rig {
  public:
   explicit Rig(const OnboardConfig& c, std::int64_t t0_ms = 1'000) : peer_(c.radio), stream_(0.0, t0_ms) {
     auto r = OnboardUnit::Create(c);
-    EXPECT_EQ(r.check.error, ConfigError::kNone) << ToString(r.check.error);
+    EXPECT_EQ(r.check.error, OnboardConfigError::kNone) << ToString(r.check.error);
     unit_.emplace(std::move(*r.unit));
   }
   const OnboardOutputs& Step(const ra::test::Kinematics& k = {}, const ra::test::ImuValues& imu = {}) {

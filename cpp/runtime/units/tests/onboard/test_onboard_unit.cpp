@@ -14,12 +14,12 @@
 namespace railproof::units::test {
 namespace {
 
-ConfigError CreateError(const OnboardConfig& c) { return OnboardUnit::Create(c).check.error; }
+OnboardConfigError CreateError(const OnboardConfig& c) { return OnboardUnit::Create(c).check.error; }
 
 TEST(OnboardUnitConfig, AcceptsTheTestLine) {
   const Line line;
   const auto r = OnboardUnit::Create(Config(line));
-  EXPECT_EQ(r.check.error, ConfigError::kNone);
+  EXPECT_EQ(r.check.error, OnboardConfigError::kNone);
   EXPECT_TRUE(r.unit.has_value());
 }
 
@@ -28,16 +28,16 @@ TEST(OnboardUnitConfig, RefusesEachBadPartWithItsReason) {
   {
     OnboardConfig c = Config(line);
     c.radio_period_ms = 150;
-    EXPECT_EQ(CreateError(c), ConfigError::kPeriods);
+    EXPECT_EQ(CreateError(c), OnboardConfigError::kPeriods);
     c = Config(line);
     c.radio_offset_ms = c.radio_period_ms + kOnboardCycleMs;
-    EXPECT_EQ(CreateError(c), ConfigError::kPeriods);
+    EXPECT_EQ(CreateError(c), OnboardConfigError::kPeriods);
   }
   {
     Line bad;
     bad.blocks[3] = bad.blocks[2];
     const auto r = OnboardUnit::Create(Config(bad));
-    EXPECT_EQ(r.check.error, ConfigError::kBlocks);
+    EXPECT_EQ(r.check.error, OnboardConfigError::kBlocks);
     EXPECT_EQ(r.check.entry, 3U);
     EXPECT_FALSE(r.unit.has_value());
   }
@@ -45,28 +45,28 @@ TEST(OnboardUnitConfig, RefusesEachBadPartWithItsReason) {
     Line bad;
     bad.balises.push_back({7, 3'000'000});
     const auto r = OnboardUnit::Create(Config(bad));
-    EXPECT_EQ(r.check.error, ConfigError::kBalises);
+    EXPECT_EQ(r.check.error, OnboardConfigError::kBalises);
     EXPECT_EQ(r.check.entry, 2U);
   }
   {
     OnboardConfig c = Config(line);
     c.odometry.wheel_diameter_um = 100;
     const auto r = OnboardUnit::Create(c);
-    EXPECT_EQ(r.check.error, ConfigError::kOdometry);
+    EXPECT_EQ(r.check.error, OnboardConfigError::kOdometry);
     EXPECT_EQ(r.check.odometry, ra::ConfigError::kWheelDiameter);
   }
   {
     OnboardConfig c = Config(line);
     c.train.beta_n7_mm_s2 = c.train.beta_e_mm_s2 + 1;
     const auto r = OnboardUnit::Create(c);
-    EXPECT_EQ(r.check.error, ConfigError::kTrainData);
+    EXPECT_EQ(r.check.error, OnboardConfigError::kTrainData);
     EXPECT_EQ(r.check.braking, br::CreateError::kServiceAboveEmergency);
   }
   {
     Line bad;
     bad.limits = {{0, 5'000'000, 20'000}, {4'000'000, 10'000'000, 10'000}};
     const auto r = OnboardUnit::Create(Config(bad));
-    EXPECT_EQ(r.check.error, ConfigError::kLineProfile);
+    EXPECT_EQ(r.check.error, OnboardConfigError::kLineProfile);
     EXPECT_EQ(r.check.profile.verdict, br::ProfileVerdict::kOverlap);
     EXPECT_TRUE(r.check.profile.in_restrictions);
   }
@@ -74,20 +74,20 @@ TEST(OnboardUnitConfig, RefusesEachBadPartWithItsReason) {
     Line bad;
     bad.crossings.push_back({6, 2'000'000, 2'010'000, 30'000});
     const auto r = OnboardUnit::Create(Config(bad));
-    EXPECT_EQ(r.check.error, ConfigError::kCrossings);
+    EXPECT_EQ(r.check.error, OnboardConfigError::kCrossings);
     EXPECT_EQ(r.check.crossings, lc::onboard::ProtectionError::kCrossingUnsorted);
   }
   {
     OnboardConfig c = Config(line);
     c.link_key.reset();
-    EXPECT_EQ(CreateError(c), ConfigError::kRadio);
+    EXPECT_EQ(CreateError(c), OnboardConfigError::kRadio);
     c = Config(line);
     c.radio.role = tg::Role::kGround;
-    EXPECT_EQ(CreateError(c), ConfigError::kRadio);
+    EXPECT_EQ(CreateError(c), OnboardConfigError::kRadio);
     c = Config(line);
     c.radio.peer_id = c.radio.own_id;
     const auto r = OnboardUnit::Create(c);
-    EXPECT_EQ(r.check.error, ConfigError::kRadio);
+    EXPECT_EQ(r.check.error, OnboardConfigError::kRadio);
     EXPECT_EQ(r.check.radio, tg::ConfigError::kSameIds);
   }
 }

@@ -93,7 +93,7 @@ struct OnboardConfig {
                                                // (0 .. radio_period_ms)
 };
 
-enum class ConfigError : std::uint8_t {
+enum class OnboardConfigError : std::uint8_t {
   kNone,
   kPeriods,          // supervision cycle, radio period or offset not a multiple of the cycle,
                      // offset not below the period
@@ -107,7 +107,7 @@ enum class ConfigError : std::uint8_t {
   kOutOfMemory,
 };
 
-constexpr const char* ToString(ConfigError e) noexcept {
+constexpr const char* ToString(OnboardConfigError e) noexcept {
   return core::EnumName(e, std::array<const char*, 10>{"NONE", "PERIODS", "BLOCKS", "BALISES", "ODOMETRY",
                                                        "TRAIN_DATA", "LINE_PROFILE", "CROSSINGS", "RADIO",
                                                        "OUT_OF_MEMORY"});
@@ -115,7 +115,7 @@ constexpr const char* ToString(ConfigError e) noexcept {
 
 // The first error of a configuration and the module's own reason.
 struct ConfigCheck {
-  ConfigError error = ConfigError::kNone;
+  OnboardConfigError error = OnboardConfigError::kNone;
   std::size_t entry = 0;
   ra::ConfigError odometry = ra::ConfigError::kNone;
   br::CreateError braking = br::CreateError::kNone;
