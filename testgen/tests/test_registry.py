@@ -32,7 +32,8 @@ def test_the_tree_agrees_with_the_registry(cli, repo):
     r = _check(cli, repo)
     assert r.rc == 0, r.err
     reg = registry.load(repo / "spec")
-    assert [c.name for c in reg.capabilities] == ["tg", "mb", "br", "ra", "lc"]
+    assert [c.name for c in reg.capabilities] == ["tg", "mb", "br", "ra", "lc", "fc"]
+    assert [f.id for f in reg.units.faults][:2] == ["FAULT_UNIT_REAR_FOR_FRONT", "FAULT_UNIT_RESTRICTION_DROPPED"]
     assert reg.of_area("SC").name == "br"
     assert reg.of_model("models/lc.pml").name == "lc"
 
@@ -42,7 +43,8 @@ def test_cmake_variables_and_fault_identifiers_come_from_the_registry(cli, tmp_p
             "--faults-header", tmp_path / "f.hpp")
     assert r.rc == 0, r.err
     cmake = (tmp_path / "c.cmake").read_text(encoding="utf-8")
-    assert "set(RAILPROOF_CAPABILITIES tg mb br ra lc)" in cmake
+    assert "set(RAILPROOF_CAPABILITIES tg mb br ra lc fc)" in cmake
+    assert "set(RAILPROOF_CAP_units_FAULTS_UNIT FAULT_UNIT_REAR_FOR_FRONT" in cmake
     assert "set(RAILPROOF_CAP_br_AREAS BR SC)" in cmake
     assert "FAULT_LC_CLEAR_ON_ANY_CLOSED" in cmake
     header = (tmp_path / "f.hpp").read_text(encoding="utf-8")
@@ -65,14 +67,18 @@ def test_cmake_variables_and_fault_identifiers_come_from_the_registry(cli, tmp_p
     (("spec/capabilities.yaml", "id: FAULT_LC_STALE_CONFIRMATION", "id: FAULT_MB_STALE_CONFIRMATION"),
      "spec/capabilities.yaml", "FAULT_MB_STALE_CONFIRMATION", "a fault of lc is named FAULT_<area>_"),
     # a fault of the units' glue without a site in cpp/runtime/units/src, and one of another area
-    (("spec/capabilities.yaml", "\ncapabilities:\n",
-      "\nunits:\n  title: the units\n  faults:\n    - {id: FAULT_UNIT_NOWHERE, text: no site, killed_by: [unit]}\n"
-      "capabilities:\n"),
+    (("spec/capabilities.yaml", "units:\n  title: The on-board and wayside units\n  faults:\n",
+      "units:\n  title: The on-board and wayside units\n  faults:\n"
+      "    - {id: FAULT_UNIT_NOWHERE, text: no site, killed_by: [unit]}\n"),
      "spec/capabilities.yaml", "FAULT_UNIT_NOWHERE", "no RAILPROOF_FAULT(FAULT_UNIT_NOWHERE) in cpp/runtime/units/src"),
-    (("spec/capabilities.yaml", "\ncapabilities:\n",
-      "\nunits:\n  title: the units\n  faults:\n    - {id: FAULT_TG_GLUE, text: misnamed, killed_by: [unit]}\n"
-      "capabilities:\n"),
+    (("spec/capabilities.yaml", "units:\n  title: The on-board and wayside units\n  faults:\n",
+      "units:\n  title: The on-board and wayside units\n  faults:\n"
+      "    - {id: FAULT_TG_GLUE, text: misnamed, killed_by: [unit]}\n"),
      "spec/capabilities.yaml", "FAULT_TG_GLUE", "a fault of units is named FAULT_<area>_... (UNIT)"),
+    # a fault site in the units' glue that is not registered
+    (("cpp/runtime/units/src/onboard/onboard_unit.cpp", "RAILPROOF_FAULT(FAULT_UNIT_REAR_FOR_FRONT)",
+      "RAILPROOF_FAULT(FAULT_UNIT_NEW)"),
+     "cpp/runtime/units/src", "FAULT_UNIT_NEW", "seeded fault not registered under units"),
     # a name that is not the first area in lower case
     (("spec/capabilities.yaml", "  - name: ra\n", "  - name: rx\n"),
      "spec/capabilities.yaml", "rx", "the name must be the lower-case first area (ra)"),
