@@ -43,6 +43,7 @@
 #include <utility>
 #include <vector>
 
+#include "railproof/offline/nlp.hpp"
 #include "railproof/br/analysis/margins.hpp"
 
 namespace railproof::br::analysis {
@@ -690,12 +691,6 @@ std::vector<double> StartVector(const MarginTnlp& nlp, const ContModel& c, const
   return z;
 }
 
-// MUMPS (Ipopt's linear solver) is not thread-safe: one solve at a time.
-std::mutex& IpoptMutex() {
-  static std::mutex mu;
-  return mu;
-}
-
 }  // namespace
 
 // @implements REQ-BR-009 REQ-BR-014 REQ-BR-005 REQ-BR-007
@@ -727,7 +722,7 @@ NlpResult NlpWorstCase(const MarginModel& m, const Location& loc, const std::vec
     Ipopt::ApplicationReturnStatus st;
     int iterations = 0;
     {
-      std::lock_guard<std::mutex> lock(IpoptMutex());
+      std::lock_guard<std::mutex> lock(offline::IpoptMutex());  // one Ipopt solve at a time in the process
       Ipopt::SmartPtr<Ipopt::IpoptApplication> app = IpoptApplicationFactory();
       app->RethrowNonIpoptException(true);
       auto o = app->Options();
