@@ -161,6 +161,24 @@ def test_chapters_follow_the_registry(clean):
     assert [p["src"] for p in clean.chapter["ra"]["plots"]] == ["plots/ra/dry_level_run.svg"]
 
 
+def test_the_units_promised_by_the_registry_must_be_tested(tmp_path):
+    """A registry with a units section (glue faults) promises the units' test set and a kill
+    run per glue fault; the system page shows the faults and the scenarios' invariants."""
+    spec, results, repo = tree(tmp_path)
+    edit_json(results / "registry.json", lambda d: d.update(
+        {"units": {"name": "units", "title": "The units", "faults": [
+            {"id": "FAULT_UNIT_GLUE", "text": "a wire crossed", "killed_by": ["unit"]}]}}))
+    ctx = evidence.context(spec, results, repo)
+    assert ctx.verdict == "FAIL"
+    assert "the units' test set (ctest entries units.*, results/tests/unit/units/) did not run" in ctx.problems
+    assert "seeded fault FAULT_UNIT_GLUE (units): no ctest entry unit_fault_FAULT_UNIT_GLUE in this run" in ctx.problems
+    assert [f["id"] for f in ctx.system["faults"]] == ["FAULT_UNIT_GLUE"]
+    assert ctx.system["scenario_rows"] and len(ctx.system["invariants"][0]) == 1 + len(ctx.system["scenario_rows"])
+    render.render_sources(ctx, repo / "evidence", tmp_path / "src")
+    page = (tmp_path / "src" / "system.rst").read_text()
+    assert ".. _chapter-units:" in page and ".. fault:: a wire crossed" in page
+
+
 def test_a_capability_is_its_registry_entry_and_its_chapter_template(tmp_path):
     spec, results, repo = tree(tmp_path)
     edit_json(results / "registry.json", lambda d: d["capabilities"].append(

@@ -13,7 +13,7 @@ from pathlib import Path
 
 from ..errors import PipelineError
 from ..toolversions import DOC_PACKAGES, package_versions
-from . import analysis, boundaries, chapters, generation, modelcheck, tests
+from . import analysis, boundaries, chapters, generation, modelcheck, system, tests
 from .text import fmt_value, need_id
 
 _ASM = re.compile(r"ASM(?:-[A-Z]+)?-\d+")
@@ -36,6 +36,7 @@ class Context:
         self._requirement_links()
         boundaries.collect(self)
         chapters.collect(self)
+        system.collect(self)
         self._versions()
         self._verdict()
 

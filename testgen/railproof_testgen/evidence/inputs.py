@@ -172,11 +172,15 @@ def load_spec(inp: Inputs) -> None:
         inp.add(f, f"spec/{f.relative_to(spec_dir).as_posix()}")
 
 
+# Design notes of no single capability that a page links to (the system page).
+SYSTEM_DESIGN_NOTES = ("design/units.md", "design/sim.md")
+
+
 def load_design_notes(inp: Inputs) -> None:
     """The design note of every registered capability (spec/design/<cap>.md), linked from
-    its chapter."""
-    for cap in inp.registry:
-        rel = cap["design"].removeprefix("spec/")
+    its chapter, and those of the units and the simulator, linked from the system page."""
+    rels = [cap["design"].removeprefix("spec/") for cap in inp.registry] + list(SYSTEM_DESIGN_NOTES)
+    for rel in rels:
         if (inp.spec_dir / rel).is_file():
             inp.add(inp.spec_dir / rel, f"spec/{rel}")
 

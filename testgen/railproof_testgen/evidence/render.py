@@ -27,7 +27,7 @@ MANIFEST_SCHEMA = "railproof/manifest/1"
 SOURCE_DATE_EPOCH = "315532800"
 # The pages rendered once each from templates/<page>.rst.jinja (besides the chapters, one
 # page per vector file, per test page and per requirement).
-PAGES = ["overview", "traceability", "hazards", "capabilities", "model_checking", "test_generation",
+PAGES = ["overview", "traceability", "hazards", "capabilities", "system", "model_checking", "test_generation",
          "tests", "seeded_faults", "analysis", "boundaries", "tool_versions", "manifest"]
 EXCLUDED = {
     ".doctrees/": "Sphinx's pickled build environment: holds absolute paths and object "
