@@ -6,4 +6,4 @@ railproof_runtime_module(wayside_unit CAPABILITY units SIDE wayside
   SOURCES src/wayside/wayside_unit.cpp src/wayside/wayside_cycle.cpp
   LINKS tg mb_wayside lc_wayside messages)
 set(RAILPROOF_UNITS_WAYSIDE_TESTS tests/wayside/test_wayside_unit.cpp tests/wayside/test_wayside_handover.cpp
-    tests/wayside/test_wayside_replay.cpp)
+    tests/wayside/test_wayside_replay.cpp tests/wayside/test_wayside_vectors.cpp)

@@ -281,6 +281,7 @@ ReceiveResult WaysideUnit::Receive(std::int64_t now_ms, std::uint32_t train_id,
   std::array<std::uint8_t, tg::kPayloadMax> payload{};
   const tg::Endpoint::RxResult rx = s->endpoint.Receive(detail::Clock32(now_ms), frame, payload);
   r.gap = rx.gap;
+  r.link = rx.link;
   if (rx.reason != tg::RejectReason::kNone) {
     r.status = FrameStatus::kFrameRejected;
     r.tg_reason = rx.reason;

@@ -31,6 +31,7 @@
 #include "ra/conformance/vector_keys.hpp"
 #include "railproof/testing/jsonl_vectors.hpp"
 #include "tg/conformance/vector_reader.hpp"
+#include "../tg_vectors.hpp"
 
 namespace railproof::units::test {
 namespace {
@@ -67,29 +68,9 @@ Loaded Load(const std::string& prefix, const rc::VectorKeys& keys) {
 
 // ---- tg ---------------------------------------------------------------------------------------
 
-std::vector<std::uint8_t> GroundFrame(const rc::RxTelegram& t, std::int64_t now_ms) {
-  tg::TelegramHeader h{};
-  h.version = tg::kVersion;
-  h.type = t.type;
-  h.src = t.src;
-  h.dst = t.dst;
-  h.seq = t.seq;
-  h.echo = t.echo.value_or(0U);
-  h.echo_valid = t.echo.has_value();
-  h.timestamp_ms = static_cast<std::uint32_t>(now_ms);
-  std::array<std::uint8_t, tg::kKeyBytes> key = kKey;
-  if (!t.with_link_key) {
-    key.back() = static_cast<std::uint8_t>(key.back() ^ 0x01U);
-  }
-  const messages::Encoded keep_alive = messages::Encode(messages::KeepAlive{});
-  tg::EncodedFrame f{};
-  EXPECT_EQ(tg::EncodeFrame(h, keep_alive.payload.View(), tg::LinkKey(key), f), tg::EncodeStatus::kOk);
-  if (t.corrupt) {  // 9 symbols of block 0: beyond the code's 8 (the tg runner's corruption)
-    for (std::size_t k = 0; k < 9; ++k) {
-      f.bytes[k * 7] = static_cast<std::uint8_t>(f.bytes[k * 7] ^ 0xA5U);
-    }
-  }
-  return {f.View().begin(), f.View().end()};
+std::span<const std::uint8_t> KeepAlivePayload() {
+  static const messages::Encoded keep_alive = messages::Encode(messages::KeepAlive{});
+  return keep_alive.payload.View();
 }
 
 // The model's time 0 is the unit's first cycle; a tick is the unit's telegram; the frames
@@ -118,7 +99,7 @@ void ReplayTg(const rc::Vector& v, const rc::FileHeader& h) {
     const std::size_t first_rx = tick ? i + 1 : i;
     std::size_t end = first_rx;
     while (end < v.steps.size() && v.steps[end].kind == rc::Step::Kind::kRx) {
-      rig.Deliver(GroundFrame(v.steps[end].tg, t0 + clock));
+      rig.Deliver(VectorFrame(v.steps[end].tg, t0 + clock, kKey, KeepAlivePayload()));
       ++end;
     }
     const OnboardOutputs& out = rig.Step();
@@ -160,7 +141,7 @@ void ReplayTg(const rc::Vector& v, const rc::FileHeader& h) {
 }
 
 TEST(OnboardReplay, TelegramVectorsOfTheTrainRole) {
-  const rc::LoadResult loaded = rc::LoadVectorDirectory(kVectors);
+  const rc::LoadResult& loaded = TgVectorSet();
   ASSERT_TRUE(loaded.ok) << loaded.error;
   std::size_t replayed = 0;
   for (const rc::Vector& v : loaded.set.vectors) {

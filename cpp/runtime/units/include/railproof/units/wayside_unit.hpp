@@ -64,8 +64,9 @@
 
 namespace railproof::units {
 
-// D5 §1 (digest §1): "one base station serves 12 trains".
-inline constexpr std::size_t kTrainsPerBaseStation = 12;
+// D5 §1 (digest §1): one base station serves 12 trains (spec/parameters/tg.yaml
+// trains_per_base_station).
+inline constexpr auto kTrainsPerBaseStation = static_cast<std::size_t>(params::tg::trains_per_base_station);
 // The ground cycle (spec/parameters/tg.yaml ground_cycle_ms, D5 §1).
 inline constexpr std::int64_t kGroundCycleMs = params::tg::ground_cycle_ms;
 // Most neighbour messages (requests or responses) per cycle and direction.
@@ -119,7 +120,7 @@ enum class ConfigError : std::uint8_t {
 };
 
 constexpr const char* ToString(ConfigError e) noexcept {
-  return core::EnumName(e, std::array<const char*, 11>{"None", "NoKeyProvider", "RadioInvalid", "LineInvalid", "BaseStationCapacityInvalid", "SecureAheadInvalid", "TooManyCrossings", "CrossingInvalid", "SchedulerInvalid", "HandoverZoneInvalid", "OutOfMemory"}, "Invalid");
+  return core::EnumName(e, std::array<const char*, 11>{"NONE", "NO_KEY_PROVIDER", "RADIO_INVALID", "LINE_INVALID", "BASE_STATION_CAPACITY_INVALID", "SECURE_AHEAD_INVALID", "TOO_MANY_CROSSINGS", "CROSSING_INVALID", "SCHEDULER_INVALID", "HANDOVER_ZONE_INVALID", "OUT_OF_MEMORY"});
 }
 
 enum class AdmitStatus : std::uint8_t {
@@ -131,7 +132,7 @@ enum class AdmitStatus : std::uint8_t {
 };
 
 constexpr const char* ToString(AdmitStatus s) noexcept {
-  return core::EnumName(s, std::array<const char*, 5>{"Admitted", "DuplicateTrain", "CapacityFull", "RadioIdInvalid", "NoKey"}, "Invalid");
+  return core::EnumName(s, std::array<const char*, 5>{"ADMITTED", "DUPLICATE_TRAIN", "CAPACITY_FULL", "RADIO_ID_INVALID", "NO_KEY"});
 }
 
 enum class RegisterStatus : std::uint8_t {
@@ -143,7 +144,7 @@ enum class RegisterStatus : std::uint8_t {
 };
 
 constexpr const char* ToString(RegisterStatus s) noexcept {
-  return core::EnumName(s, std::array<const char*, 5>{"Registered", "NotAdmitted", "AlreadyRegistered", "BaseStationFull", "GroundRefused"}, "Invalid");
+  return core::EnumName(s, std::array<const char*, 5>{"REGISTERED", "NOT_ADMITTED", "ALREADY_REGISTERED", "BASE_STATION_FULL", "GROUND_REFUSED"});
 }
 
 struct RegisterResult {
@@ -161,7 +162,7 @@ enum class FrameStatus : std::uint8_t {
 };
 
 constexpr const char* ToString(FrameStatus s) noexcept {
-  return core::EnumName(s, std::array<const char*, 4>{"Accepted", "UnknownTrain", "FrameRejected", "PayloadInvalid"}, "Invalid");
+  return core::EnumName(s, std::array<const char*, 4>{"ACCEPTED", "UNKNOWN_TRAIN", "FRAME_REJECTED", "PAYLOAD_INVALID"});
 }
 
 enum class MessageStatus : std::uint8_t {
@@ -175,7 +176,7 @@ enum class MessageStatus : std::uint8_t {
 };
 
 constexpr const char* ToString(MessageStatus s) noexcept {
-  return core::EnumName(s, std::array<const char*, 7>{"Accepted", "ReportRejected", "WrongTrain", "UnknownCrossing", "QueueFull", "NoDeparture", "UnexpectedType"}, "Invalid");
+  return core::EnumName(s, std::array<const char*, 7>{"ACCEPTED", "REPORT_REJECTED", "WRONG_TRAIN", "UNKNOWN_CROSSING", "QUEUE_FULL", "NO_DEPARTURE", "UNEXPECTED_TYPE"});
 }
 
 struct MessageResult {
@@ -188,6 +189,7 @@ struct ReceiveResult {
   FrameStatus status = FrameStatus::kAccepted;
   tg::RejectReason tg_reason = tg::RejectReason::kNone;
   std::uint32_t gap = 0;  // telegrams lost before this one (tg::Endpoint::RxResult::gap)
+  tg::LinkState link = tg::LinkState::kNone;  // the train's link after this frame
   messages::DecodeError decode_error = messages::DecodeError::kNone;
   messages::Field field = messages::Field::kNone;
   std::size_t entry = 0;
@@ -223,7 +225,7 @@ enum class HandoverVerdict : std::uint8_t {
 };
 
 constexpr const char* ToString(HandoverVerdict v) noexcept {
-  return core::EnumName(v, std::array<const char*, 3>{"Accepted", "NoRoom", "TrackNotClear"}, "Invalid");
+  return core::EnumName(v, std::array<const char*, 3>{"ACCEPTED", "NO_ROOM", "TRACK_NOT_CLEAR"});
 }
 
 // Accepting unit -> releasing unit: the verdict and, once accepted, the accepting unit's last
@@ -254,7 +256,7 @@ enum class InputStatus : std::uint8_t {
 };
 
 constexpr const char* ToString(InputStatus s) noexcept {
-  return core::EnumName(s, std::array<const char*, 7>{"UnknownCrossing", "UnknownTrain", "TooManyMessages", "ControllerRefused", "SchedulerRefused", "BaseStationFull", "HandoverRefused"}, "Invalid");
+  return core::EnumName(s, std::array<const char*, 7>{"UNKNOWN_CROSSING", "UNKNOWN_TRAIN", "TOO_MANY_MESSAGES", "CONTROLLER_REFUSED", "SCHEDULER_REFUSED", "BASE_STATION_FULL", "HANDOVER_REFUSED"});
 }
 
 struct InputEvent {
