@@ -81,7 +81,8 @@ inline const LcVectors& LcVectorSet() {
           return std::string();
         },
         [&](const conformance::VectorLineRef& line) {
-          s.vectors.push_back(conformance::JsonVector{line.id, line.test_name, line.file, line.line, (*line.obj)["steps"]});
+          s.vectors.push_back(
+              conformance::JsonVector{line.id, line.test_name, line.file, line.line, (*line.obj)["steps"]});
           return std::string();
         },
         count);

@@ -8,16 +8,21 @@
 //   mb  the on-board events of every vector, one unit per train: stop limits issued at
 //       now - age, coded by the codec and framed by the ground's endpoint; the authority's
 //       verdict, limit and usability out. The ground's own events are the wayside's.
-//   ra  the vectors at standstill without a deviation (the others need a slip the model states
-//       as predicates; no sensor stream is derived from them here): each model cycle is as many
-//       sensor cycles as the odometry's warm-up is longer than the model's (40 / 2), with the
-//       IMU or TG failing, or a balise read in the last of them; position validity and the
-//       odometry's stop demand (as the brake reason) out.
+//   ra  the vectors at standstill without a deviation: each model cycle is as many sensor
+//       cycles as the odometry's warm-up is longer than the model's (40 / 2), with the IMU or TG
+//       failing, or a balise read in the last of them; position validity and the odometry's
+//       stop demand (as the brake reason) out. Not replayed: the vectors with a deviation or
+//       motion (124 of 150). Their steps state the odometry's own comparisons as predicates per
+//       model cycle (a deviation seen, each start point's speed agreeing with the TG, the start
+//       ages, sections of abstract margin units and compensation limits of 3 or 9 cycles); a
+//       sensor stream (the odometry tests' slip stream) produces a slip that the odometry
+//       detects, but not a given sequence of those predicates at the model's cycles, so such a
+//       replay would check the stream, not the vector. They are replayed module by module (the
+//       ra runner) only.
 //   br  not replayed: the vectors give abstract pattern speeds (0..6 mm/s), which no position
 //       and stop limit produce through the pattern calculator; the decision with real patterns
 //       is checked in test_onboard_unit.cpp (SupervisesTheSafeFrontOfTheEnvelope).
-//   lc  not replayed yet: the vectors give the front and speed directly, the unit takes them
-//       from the odometry (with its envelope and the supervised speed).
+//   lc  test_onboard_crossing_replay.cpp.
 #include <gtest/gtest.h>
 
 #include <algorithm>

@@ -60,7 +60,8 @@ void ReplayTg(const rc::Vector& v, const rc::FileHeader& h) {
   c.radio = h.endpoint;
   c.radio_id = h.ground_id;
   auto created = WaysideUnit::Create(c);
-  ASSERT_EQ(created.error, ConfigError::kNone) << ToString(created.error) << " " << mb::wayside::ToString(created.line_error);
+  ASSERT_EQ(created.error, ConfigError::kNone)
+      << ToString(created.error) << " " << mb::wayside::ToString(created.line_error);
   WaysideUnit& unit = *created.unit;
   ASSERT_EQ(unit.Admit(kTgTrain, h.train_id), AdmitStatus::kAdmitted);
   std::int64_t clock = 0;
@@ -87,7 +88,8 @@ void ReplayTg(const rc::Vector& v, const rc::FileHeader& h) {
       continue;
     }
     SCOPED_TRACE("step " + std::to_string(i) + " (rx)");
-    const ReceiveResult r = unit.Receive(clock, kTgTrain, VectorFrame(s.tg, clock, KeyOf(kTgTrain), NoPositionPayload()));
+    const ReceiveResult r =
+        unit.Receive(clock, kTgTrain, VectorFrame(s.tg, clock, KeyOf(kTgTrain), NoPositionPayload()));
     EXPECT_STREQ(rc::ToString(rc::VerdictOf(r.tg_reason)), rc::ToString(e.verdict));
     EXPECT_EQ(r.gap, e.gap);
     EXPECT_EQ(r.link, e.link) << tg::ToString(r.link);
@@ -138,7 +140,8 @@ std::string Ids(std::span<const std::uint32_t> a) {
 }
 
 std::string ReportString(const messages::CrossingReport& r) {
-  return std::to_string(r.crossing_id) + " " + messages::ToString(r.status) + " ws=" + std::to_string(r.warning_start_ms) +
+  return std::to_string(r.crossing_id) + " " + messages::ToString(r.status) +
+         " ws=" + std::to_string(r.warning_start_ms) +
          " issued=" + std::to_string(r.issued_ms) + " cf=" + rc::Bool(r.clock_fault) +
          " requesters=" + Ids(std::span<const std::uint32_t>(r.requesters.data(), r.requester_count));
 }
@@ -198,9 +201,11 @@ void SendRequests(WaysideUnit& unit, std::vector<Train>& trains, const json& ste
     messages::Bundle b;
     for (; k < sequence.size() && sequence[k].first == id && b.Add(sequence[k].second); ++k) {
     }
-    const ReceiveResult r = unit.Receive(now, id, train->radio.SendPayload(now, messages::EncodeBundle(b.View()).payload.View()));
+    const ReceiveResult r =
+        unit.Receive(now, id, train->radio.SendPayload(now, messages::EncodeBundle(b.View()).payload.View()));
+    const auto taken = r.Messages();
     const bool accepted = r.status == FrameStatus::kAccepted &&
-                          std::all_of(r.messages.begin(), r.messages.begin() + static_cast<std::ptrdiff_t>(r.message_count),
+                          std::all_of(taken.begin(), taken.end(),
                                       [](const MessageResult& m) { return m.status == MessageStatus::kAccepted; });
     if (!accepted) {
       chk.Fail("train " + std::to_string(id) + "'s telegram not taken: " + ToString(r.status) + "/" +
@@ -212,8 +217,8 @@ void SendRequests(WaysideUnit& unit, std::vector<Train>& trains, const json& ste
 void ReplayLc(const LcFile& f, const rc::JsonVector& v, std::vector<std::string>& problems) {
   const mb::wayside::test::LineData line = StraightLine(f.restrictions.back().end_mm);
   WaysideConfig c = BaseConfig(line);
-  const std::int64_t tick = v.steps.size() > 1 ? v.steps[1].at("t_ms").get<std::int64_t>() - v.steps[0].at("t_ms").get<std::int64_t>()
-                                               : 10'000;
+  const auto t_ms = [&](std::size_t k) { return v.steps.at(k).at("t_ms").get<std::int64_t>(); };
+  const std::int64_t tick = v.steps.size() > 1 ? t_ms(1) - t_ms(0) : 10'000;
   // the model's tick is the ground cycle: the links must outlive two of them
   c.radio.turnaround_ms = static_cast<std::uint32_t>(2 * tick);
   c.radio.link_timeout_ms = static_cast<std::uint32_t>(2 * tick);
@@ -250,8 +255,9 @@ void ReplayLc(const LcFile& f, const rc::JsonVector& v, std::vector<std::string>
     SendRequests(unit, trains, step, now, chk);
     std::vector<CrossingSensors> sensors;
     for (const json& x : step.at("controllers")) {
-      sensors.push_back(CrossingSensors{x.at("crossing_id").get<std::uint32_t>(), x.at("in").at("barrier_down").get<bool>(),
-                                        x.at("in").at("barrier_up").get<bool>(), lc::wayside::ClockInput::kGnss});
+      const json& xin = x.at("in");
+      sensors.push_back(CrossingSensors{x.at("crossing_id").get<std::uint32_t>(), xin.at("barrier_down").get<bool>(),
+                                        xin.at("barrier_up").get<bool>(), lc::wayside::ClockInput::kGnss});
     }
     const CycleOutput& out = unit.Cycle(now, CycleInput{sensors, {}, {}});
     // what each train decodes from its frame
@@ -259,7 +265,8 @@ void ReplayLc(const LcFile& f, const rc::JsonVector& v, std::vector<std::string>
     for (Train& t : trains) {
       heard[t.id] = t.radio.Take(now, out);
       if (heard[t.id].size == 0) {
-        chk.Fail("train " + std::to_string(t.id) + " got no frame it accepts (" + tg::ToString(t.radio.LastReason()) + ")");
+        chk.Fail("train " + std::to_string(t.id) + " got no frame it accepts (" +
+                 tg::ToString(t.radio.LastReason()) + ")");
       }
     }
     const json& controllers = step.at("controllers");
@@ -281,7 +288,8 @@ void ReplayLc(const LcFile& f, const rc::JsonVector& v, std::vector<std::string>
       chk.Expect(pre + "report", ReportString(e.at("report")), ReportString(shift.ToModel(o->report)));
       chk.Expect(pre + "state", e.at("state").get<std::string>(), lc::wayside::ToString(ctl->Status().state));
       if (!e.at("warning_start_ms").is_null()) {
-        chk.Expect(pre + "warning_start_ms", rc::OptInt(e.at("warning_start_ms")), std::to_string(shift.ToModel(ctl->Status().warning_start_ms)));
+        chk.Expect(pre + "warning_start_ms", rc::OptInt(e.at("warning_start_ms")),
+                   std::to_string(shift.ToModel(ctl->Status().warning_start_ms)));
       }
       chk.Expect(pre + "failure", e.at("failure").get<std::string>(), lc::wayside::ToString(ctl->Status().failure));
       chk.Expect(pre + "requesters", Ids(e.at("requesters")), Ids(ctl->Status().Requesters()));
@@ -297,8 +305,8 @@ void ReplayLc(const LcFile& f, const rc::JsonVector& v, std::vector<std::string>
             acked = acked || a->train_id == t.id;
           }
         }
-        chk.Expect(tpre + "report", Lists(e.at("report").at("requesters"), t.id) ? ReportString(e.at("report")) : "none",
-                   report);
+        const bool listed = Lists(e.at("report").at("requesters"), t.id);
+        chk.Expect(tpre + "report", listed ? ReportString(e.at("report")) : "none", report);
         chk.Expect(tpre + "withdrawal acknowledged", rc::Bool(Lists(e.at("withdrawal_acks"), t.id)), rc::Bool(acked));
       }
     }
