@@ -694,7 +694,7 @@ TEST(WaysideGroundD2, BuffersRoundedUp) {
   PositionReport r = MakeReport(*g, 1, 1'334'567);
   r.last_balise_mm = 100'000;
   r.speed_mm_s = 22'223;
-  r.correction_mm = 999'999;  // ignored under the D2 policy
+  r.correction_mm = 1'000;  // below r(x - x_m): D2's rate governs
   ASSERT_EQ(g->OnReport(r), ReportStatus::kAccepted);
   auto ext = g->Extended(1);
   ASSERT_TRUE(ext.has_value());
@@ -718,6 +718,15 @@ TEST(WaysideGroundD2, BuffersRoundedUp) {
   ext = g->Extended(1);
   EXPECT_EQ(ext->begin_mm, 1'400'001 - 100'000 - 2'001);
   EXPECT_EQ(ext->end_mm, 1'400'001 + 2'001);
+  // the train's own bound above D2's rate (a compensating odometry): it governs both ends
+  r = MakeReport(*g, 1, 1'400'010);
+  r.last_balise_mm = 400'010;  // r(x - x_m) = 1000 mm
+  r.speed_mm_s = 20'000;
+  r.correction_mm = 7'500;
+  ASSERT_EQ(g->OnReport(r), ReportStatus::kAccepted);
+  ext = g->Extended(1);
+  EXPECT_EQ(ext->begin_mm, 1'400'010 - 100'000 - (7'500 + 2'000));
+  EXPECT_EQ(ext->end_mm, 1'400'010 + (7'500 + 10'000 + 2'000));
   // registration under D2: the uncertainty plus l_c at both ends
   ASSERT_EQ(Register(*g, 3, 200'000, 500), RegisterStatus::kRegistered);
   ext = g->Extended(3);

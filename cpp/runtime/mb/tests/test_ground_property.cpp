@@ -152,7 +152,8 @@ class PropertyRun {
       ASSERT_EQ(ground_->OnReport(r), ReportStatus::kAccepted);
       t.rep_front = t.true_front;
       if (policy_ == MarginPolicy::kD2Buffers) {
-        const std::int64_t odo = (line_.base.d2.rate_ppm * (t.true_front - r.last_balise_mm) + 999'999) / 1'000'000;
+        const std::int64_t odo =
+            std::max((line_.base.d2.rate_ppm * (t.true_front - r.last_balise_mm) + 999'999) / 1'000'000, corr);
         const std::int64_t delay = (r.speed_mm_s * line_.base.d2.tau_ms + 999) / 1000;
         t.corr_front = odo + delay + line_.base.d2.resolution_mm;
         t.corr_rear = odo + line_.base.d2.resolution_mm;

@@ -26,8 +26,8 @@ void Ground::UpdateExtended(TrainState& t) noexcept {
 }
 
 // Length corrections by the margin policy (design §3.6): the reported correction at both
-// ends, or the D2 safety buffers l_f = ceil(r|x - x_m|) + ceil(v tau) + l_c,
-// l_r = ceil(r|x - x_m|) + l_c (rounded up: conservative).
+// ends, or the D2 safety buffers l_f = e + ceil(v tau) + l_c, l_r = e + l_c with
+// e = max(ceil(r|x - x_m|), reported correction) (rounded up: conservative).
 // @implements REQ-MB-002
 // @implements REQ-MB-003
 // @implements REQ-MB-019
@@ -40,7 +40,9 @@ void Ground::SetPosition(TrainState& t, std::int64_t front_mm, std::int64_t corr
   }
   if (policy_ == MarginPolicy::kD2Buffers) {
     const std::int64_t run = front_mm >= last_balise_mm ? front_mm - last_balise_mm : last_balise_mm - front_mm;
-    const std::int64_t odometry = CeilDiv(d2_.rate_ppm * run, kPpm);
+    // D2's rate r(x - x_m) bounds a plain tachogenerator odometry; the train's own bound (its
+    // reported correction: compensation and margins included) may be larger, and then governs.
+    const std::int64_t odometry = std::max(CeilDiv(d2_.rate_ppm * run, kPpm), correction_mm);
     const std::int64_t delay = CeilDiv(speed_mm_s * d2_.tau_ms, kMsPerS);
     t.corr_front_mm = odometry + delay + d2_.resolution_mm;
     t.corr_rear_mm = odometry + d2_.resolution_mm;

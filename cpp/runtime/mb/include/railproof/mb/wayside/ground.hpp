@@ -99,7 +99,7 @@ struct Margins {
 // @implements REQ-MB-019
 enum class MarginPolicy : std::uint8_t {
   kReportedCorrection,  // corr_r = corr_f = reported length correction
-  kD2Buffers,           // corr_f = ceil(r(x-x_m)) + ceil(v tau) + l_c, corr_r = ceil(r(x-x_m)) + l_c
+  kD2Buffers,           // corr_f = e + ceil(v tau) + l_c, corr_r = e + l_c, e = max(ceil(r(x-x_m)), corr)
 };
 
 // D2 §3.1 safety-buffer parameters (REQ-MB-019).
