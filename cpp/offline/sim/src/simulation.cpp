@@ -10,25 +10,86 @@
 #include <string>
 #include <utility>
 
+#include "railproof/generated/ra_params.hpp"
 #include "railproof/tg/aead.hpp"
 
 namespace railproof::sim {
 
+namespace {
+
+// The link keys of the line's key management: each train's key, drawn at setup.
+bool KeyOf(const void* context, std::uint32_t train_id, std::array<std::uint8_t, tg::kKeyBytes>& key) {
+  const auto& trains = *static_cast<const std::vector<std::unique_ptr<TrainRt>>*>(context);
+  for (const auto& t : trains) {
+    if (t->spec.id == train_id) {
+      key = t->key;
+      return true;
+    }
+  }
+  return false;
+}
+
+}  // namespace
+
 void Simulation::Impl::Setup() {
   rl = &SelectRunningLine(sc, line);
   CheckScenarioAgainstLine(sc, *rl);
+  if (sc.step_ms != units::kOnboardCycleMs) {
+    throw InputError(sc.file + ": step_ms: must be the on-board unit's cycle, " +
+                     std::to_string(units::kOnboardCycleMs) + " ms, got " + std::to_string(sc.step_ms));
+  }
+  if (sc.report_period_ms % units::kOnboardCycleMs != 0 || sc.ground_cycle_ms % units::kOnboardCycleMs != 0) {
+    throw InputError(sc.file + ": report_period_ms, ground_cycle_ms: must be multiples of the on-board cycle");
+  }
   channel = Channel(ChannelConfig{sc.channel.loss_probability, sc.channel.min_delay_ms, sc.channel.max_delay_ms,
                                   sc.channel.corrupt_probability},
                     sc.seed);
-  odo_prng = Prng(sc.seed ^ 0x0D0D0D0D0D0D0D0DULL);
   gl = BuildGroundLine(line, *rl,
                        sc.margin_policy == MarginPolicy::kD2 ? mb::wayside::MarginPolicy::kD2Buffers
                                                              : mb::wayside::MarginPolicy::kReportedCorrection,
                        sc.ground_cycle_ms);
-  ground = CreateGround(line, *rl, gl, sc.trains.size(), 0);
-  if (sc.boundary_accepted && rl->system_boundary_mm) {
-    ground->AcceptAtBoundary(true);
+  SetupOnboardLine();
+  Prng key_prng(sc.seed ^ 0x6B65796B65796B65ULL);
+  for (std::size_t i = 0; i < sc.trains.size(); ++i) {
+    const TrainSpec& spec = sc.trains[i];
+    auto t = std::make_unique<TrainRt>();
+    t->spec = spec;
+    t->length_mm = ToMm(spec.performance.length_m);
+    for (const auto& type : types) {
+      if (type.length_mm == t->length_mm) {
+        t->type = &type;
+      }
+    }
+    if (t->type == nullptr) {
+      throw InputError(sc.file + ": " + spec.entry + ": no train type of length " + Fmt(spec.performance.length_m) +
+                       " m (the on-board unit's train data)");
+    }
+    t->limits = PermittedProfile(*rl, t->type->MaxSpeedMmS());
+    // The vehicle must be the one the unit's data describe: no more traction than the patterns'
+    // run-up assumes, brakes no weaker than the pattern decelerations (REQ-BR-010). A train
+    // that is not is simulated as it is (a finding, not an input error): its overruns are
+    // what the invariants are there to catch.
+    const br::TrainData td = ToTrainData(*t->type);
+    const TrainPerformance& p = spec.performance;
+    const auto finding = [&](const std::string& what) {
+      train_data_findings.push_back(spec.entry + ": " + what + " (train type " + t->type->name + ")");
+    };
+    if (ToMm(p.accel_mps2) > td.accel_max_mm_s2) {
+      finding("accel_mps2 above the type's accel_max");
+    }
+    if (ToMm(p.service_decel_mps2) < td.beta_n7_mm_s2) {
+      finding("service_decel_mps2 below the service pattern deceleration");
+    }
+    if (ToMm(p.emergency_decel_mps2) < td.beta_e_mm_s2) {
+      finding("emergency_decel_mps2 below the emergency pattern deceleration");
+    }
+    t->motion.position = ToM(spec.initial_front_mm);
+    for (auto& b : t->key) {
+      b = static_cast<std::uint8_t>(key_prng.Next() >> 56U);
+    }
+    trains.push_back(std::move(t));
   }
+  SetupWayside();
   for (std::size_t p = 0; p < gl.points.size(); ++p) {
     bool running_reverse = false;
     for (const auto& r : gl.routes) {
@@ -38,20 +99,7 @@ void Simulation::Impl::Setup() {
       }
     }
     points_running_reverse.push_back(running_reverse);
-    points_reverse.push_back(ground->PointsReverse(p));
-  }
-  Prng key_prng(sc.seed ^ 0x6B65796B65796B65ULL);
-  for (const auto& spec : sc.trains) {
-    auto t = std::make_unique<TrainRt>();
-    t->spec = spec;
-    t->length_mm = ToMm(spec.performance.length_m);
-    t->motion.position = ToM(spec.initial_front_mm);
-    std::array<std::uint8_t, tg::kKeyBytes> kb{};
-    for (auto& b : kb) {
-      b = static_cast<std::uint8_t>(key_prng.Next() >> 56U);
-    }
-    t->key = std::make_unique<tg::LinkKey>(kb);
-    trains.push_back(std::move(t));
+    points_reverse.push_back(Ground().PointsReverse(p));
   }
   for (const auto& f : sc.faults) {
     FaultRt fr;
@@ -59,9 +107,64 @@ void Simulation::Impl::Setup() {
     faults.push_back(fr);
   }
   for (const char* id : {"REQ-MB-007", "REQ-MB-008", "REQ-MB-009", "REQ-MB-011", "REQ-MB-013", "REQ-MB-014",
-                         "ASM-013"}) {
+                         "ASM-013", "REQ-BR-004", "REQ-RA-012"}) {
     checks[id];
   }
+  if (!crossings.empty()) {
+    checks["REQ-LC-002"];
+    checks["REQ-LC-003"];
+  }
+}
+
+// The on-board track database: blocks, gradients, balises (ids by index), crossings (ids by
+// index, as the wayside unit's) and the odometry sections (one per gradient segment with its
+// magnitude, the odometry's longest compensation time).
+void Simulation::Impl::SetupOnboardLine() {
+  obl.blocks_mm = rl->blocks_mm;
+  obl.gradients = GradientProfile(*rl);
+  for (std::size_t i = 0; i < rl->balises.size(); ++i) {
+    obl.balises.push_back(units::BaliseEntry{static_cast<std::uint32_t>(i + 1), rl->balises[i].position_mm});
+  }
+  for (std::size_t i = 0; i < rl->level_crossings.size(); ++i) {
+    const LevelCrossing& c = rl->level_crossings[i];
+    const auto id = static_cast<std::uint32_t>(i + 1);
+    obl.crossings.push_back(lc::CrossingData{id, c.NearMm(), c.FarMm(), c.warning_time_ms});
+    CrossingRt x;
+    x.id = id;
+    x.name = c.id;
+    x.near_mm = c.NearMm();
+    x.far_mm = c.FarMm();
+    x.warning_time_ms = c.warning_time_ms;
+    crossings.push_back(x);
+    crossing_inputs.push_back(units::CrossingSensors{id, false, true, lc::wayside::ClockInput::kGnss});
+  }
+  for (const auto& g : rl->gradients) {
+    ra::OdometrySection s;
+    s.begin_mm = g.section.begin_mm;
+    s.end_mm = g.section.end_mm;
+    s.gradient_permille_x10 = static_cast<std::int32_t>(std::abs(g.permille_x10));
+    s.max_compensation_ms = params::ra::max_compensation_ms;
+    obl.sections.push_back(s);
+  }
+}
+
+void Simulation::Impl::SetupWayside() {
+  units::WaysideConfig c;
+  c.radio_id = kGroundId;
+  c.radio = tg::DeploymentConfig(tg::Role::kGround, kGroundId, static_cast<std::uint16_t>(kGroundId + 1));
+  c.keys = &KeyOf;
+  c.key_context = &trains;
+  c.line = gl.config;
+  c.capacity = GroundCapacity(gl, sc.trains.size());
+  c.secure_ahead_mm = ToMm(sc.handover_secure_ahead_m);
+  c.crossings = obl.crossings;
+  auto created = units::WaysideUnit::Create(c);
+  if (created.error != units::ConfigError::kNone) {
+    throw InputError(line.file + ": running line '" + rl->id + "': the wayside unit refuses the line: " +
+                     units::ToString(created.error) + " (" + mb::wayside::ToString(created.line_error) + ", entry " +
+                     std::to_string(created.entry) + ")");
+  }
+  wayside = std::move(created.unit);
 }
 
 void Simulation::Impl::Emit(Json ev) {
@@ -125,7 +228,6 @@ bool Simulation::Impl::Step() {
   if (now % sc.ground_cycle_ms == 0) {
     GroundCycle();
   }
-  SendReports();
   MoveTrains();
   now += sc.step_ms;
   CheckInvariants();
@@ -133,7 +235,8 @@ bool Simulation::Impl::Step() {
   return true;
 }
 
-Simulation::Simulation(Scenario scenario, Line line) : impl_(std::make_unique<Impl>(std::move(scenario), std::move(line))) {
+Simulation::Simulation(Scenario scenario, Line line, std::vector<TrainType> types)
+    : impl_(std::make_unique<Impl>(std::move(scenario), std::move(line), std::move(types))) {
   if (tg::CryptoInit() != tg::AeadStatus::kOk) {
     throw std::runtime_error("libsodium could not be initialised");
   }
@@ -193,12 +296,19 @@ std::vector<TrainView> Simulation::Trains() const {
     v.front_m = t->motion.position;
     v.rear_m = t->Rear();
     v.speed_mps = t->motion.speed;
-    if (const auto lim = t->auth.Limit()) {
-      v.limit_m = ToM(*lim);
+    if (const units::OnboardOutputs* o = t->Out()) {
+      if (o->authority_limit_mm) {
+        v.limit_m = ToM(*o->authority_limit_mm);
+      }
+      if (o->indications.limit_mm) {
+        v.supervised_limit_m = ToM(*o->indications.limit_mm);
+      }
+      v.permitted_speed_mps = static_cast<double>(o->indications.permitted_speed_mm_s) / 1000.0;
+      v.brake = units::ToString(o->brake);
+      v.authority_usable = o->authority_usable;
+      v.link_up = o->link == tg::LinkState::kUp;
     }
-    v.authority_usable = t->auth.Usable(impl_->now);
-    v.link_up = t->link_up;
-    v.emergency = t->eb;
+    v.emergency = t->brake == Brake::kEmergency;
     v.abnormal = t->abnormal;
     v.stops_made = t->stops_made;
     v.emergency_brakes = t->emergency_brakes;

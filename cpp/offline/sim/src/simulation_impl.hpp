@@ -1,9 +1,12 @@
 // The line simulation's state and its steps (private to cpp/offline/sim/src). One step of
 // simulation.hpp is carried out by these files, one job each:
-//   simulation.cpp              setup, the step, the event log and violation records
-//   simulation_schedule.cpp     scheduled commands and fault windows
-//   simulation_radio.cpp        telegrams between the trains and the ground, the ground cycle
-//   simulation_trains.cpp       entry and exit, driving, dynamics and odometry
+//   simulation.cpp              setup (the units' configurations), the step, the event log and
+//                               violation records
+//   simulation_schedule.cpp     scheduled commands (through the wayside unit) and fault windows
+//   simulation_radio.cpp        frames between the units through the channel, the ground cycle,
+//                               the crossings' equipment
+//   simulation_trains.cpp       entry and exit, the on-board unit's cycle, the driver, the true
+//                               motion and the sensors
 //   simulation_invariants.cpp   the safety invariants
 //   simulation_summary.cpp      measurements, the gap and the summary (Simulation::Gap, ::Summary)
 //   simulation_diagram.cpp      the time-distance diagram (Simulation::Svg)
@@ -25,15 +28,17 @@
 
 #include <nlohmann/json.hpp>
 
+#include "railproof/generated/br_params.hpp"
 #include "railproof/generated/mb_params.hpp"
 #include "railproof/generated/tg_params.hpp"
-#include "railproof/mb/onboard/authority.hpp"
-#include "railproof/mb/wayside/ground.hpp"
 #include "railproof/offline/dynamics.hpp"
+#include "railproof/offline/train_type.hpp"
 #include "railproof/sim/channel.hpp"
 #include "railproof/sim/ground_line.hpp"
+#include "railproof/sim/sensors.hpp"
 #include "railproof/sim/simulation.hpp"
-#include "railproof/tg/endpoint.hpp"
+#include "railproof/units/onboard_unit.hpp"
+#include "railproof/units/wayside_unit.hpp"
 
 namespace railproof::sim {
 
@@ -43,17 +48,24 @@ using Json = nlohmann::ordered_json;
 namespace internal {
 
 constexpr auto kGroundId = static_cast<std::uint16_t>(params::tg::ground_id);
-// Station stops: comfortable deceleration as a share of the service deceleration, and
-// the creep speed / stop window of the stopping controller.
+// The driver: aims this far below the indicated permitted speed, and brakes for a station
+// stop with this share of the train's service deceleration, creeping the last metres.
+constexpr double kDrivingMarginMps = 2.0 / 3.6;
 constexpr double kStationDecelShare = 0.7;
+constexpr double kDriverResponseS = 1.0;  // closes a speed difference at (difference / this)
+// Traction and brakes change the applied acceleration at most this fast (m/s^3): a brake
+// builds up within the free-running times of the train types' patterns (0.5 s and more).
+constexpr double kApplyRateMps3 = 1.5;
 constexpr double kCreepMps = 0.5;
-constexpr double kStopWindowM = 1.0;
-// A train leaves the line (is removed from the ground) when it stands within this
-// distance of an END_OF_TRACK limit's service-curve origin and has no stop left.
-constexpr double kExitWindowM = 3.0;
-// Odometry under-reads by up to this share of the correction rate (so the extended range
-// always covers the true range, and the reported front never moves backwards).
-constexpr double kOdometryErrorShare = 0.9;
+constexpr double kStopWindowM = 2.0;
+// A train leaves the line when it stands with no stop left before an END_OF_TRACK limit (or
+// a system boundary no neighbour accepts) within this distance of its supervised front.
+constexpr double kExitWindowM = 60.0;
+// A train standing this long with its odometry stopped is re-fixed (the unit restarted).
+constexpr std::int64_t kRefixAfterMs = 30000;
+// The barriers of a level crossing take this long from the command to the "down" detection
+// (below the controller's barrier_timeout_ms, params::lc).
+constexpr std::int64_t kBarrierTravelMs = 6000;
 
 inline double Round(double v, double unit) { return std::round(v / unit) * unit; }
 inline double R2(double v) { return Round(v, 0.01); }
@@ -61,9 +73,6 @@ inline double R1(double v) { return Round(v, 0.1); }
 inline std::int64_t ToMm(double m) { return static_cast<std::int64_t>(std::llround(m * 1000.0)); }
 inline double ToM(std::int64_t mm) { return static_cast<double>(mm) / 1000.0; }
 inline double ToS(std::int64_t ms) { return static_cast<double>(ms) / 1000.0; }
-inline std::uint32_t Clock32(std::int64_t ms) { return static_cast<std::uint32_t>(static_cast<std::uint64_t>(ms) & 0xFFFFFFFFULL); }
-
-inline const char* VerdictName(tg::RejectReason r) { return tg::ToString(r); }
 
 enum class Phase : std::uint8_t { kPending, kStanding, kRunning, kDwelling, kExited };
 inline const char* ToString(Phase p) {
@@ -84,33 +93,47 @@ struct Sample {
   double limit_m;  // NaN: no usable authority
 };
 
+// The line as the on-board unit's track database holds it (spans of units::LineData).
+struct OnboardLine {
+  std::vector<std::int64_t> blocks_mm;
+  std::vector<core::GradientSegment> gradients;
+  std::vector<core::RestrictionSegment> speed_limits;  // per train type (capped at its maximum)
+  std::vector<units::BaliseEntry> balises;             // id = index + 1 in the running line
+  std::vector<lc::CrossingData> crossings;             // id = index + 1 in the running line
+  std::vector<ra::OdometrySection> sections;
+};
+
+// The brake the train's equipment applies (from the unit's demand and the driver).
+enum class Brake : std::uint8_t { kNone, kDriver, kService, kEmergency };
+
 struct TrainRt {
   TrainSpec spec;
+  const TrainType* type = nullptr;
   std::int64_t length_mm = 0;
   Phase phase = Phase::kPending;
-  Motion motion;
-  // on-board odometry
-  double est_front_m = 0.0;
-  double balise_est_m = 0.0;     // estimated position at the last fix
-  double balise_true_m = 0.0;    // true position at the last fix
-  double odo_error = 0.0;        // relative (<= 0) in the current balise segment
-  std::int64_t last_balise_mm = 0;
-  std::size_t next_balise = 0;
-  // radio
-  std::unique_ptr<tg::LinkKey> key;
-  tg::Endpoint train_ep;
-  tg::Endpoint ground_ep;
-  bool link_up = false;
-  // on board
-  mb::onboard::AuthorityReceiver auth{mb::onboard::DefaultAuthorityConfig()};
-  mb::onboard::SpeedRestrictionStore tsr;
-  messages::Obstruction limit_kind = messages::Obstruction::kNone;
-  bool eb = false;  // emergency brake applied, held until standstill and a usable authority
+  Motion motion;  // the true front and speed
+  double previous_front_m = 0.0;  // before the last step
+  // the on-board unit, its track database (per train type) and its inputs of the next cycle
+  std::unique_ptr<units::OnboardUnit> unit;
+  std::unique_ptr<SensorModel> sensors;
+  std::vector<core::RestrictionSegment> limits;  // the line's, capped at the type's maximum
+  ra::CycleInput next_sensors{};
+  std::optional<std::uint32_t> next_balise;
+  std::vector<std::vector<std::uint8_t>> inbox;  // frames received for the next cycle
+  std::size_t next_balise_index = 0;             // the next balise the true front reaches
+  std::array<std::uint8_t, tg::kKeyBytes> key{};
+  // driver and brake equipment
+  br::DriverInputs driver{};
+  bool eb_hold = false;  // emergency brake applied: held until standstill
+  double applied_mps2 = 0.0;  // traction minus brake as the equipment applies it
+  Brake brake = Brake::kNone;
   std::size_t next_stop = 0;
   std::int64_t dwell_until_ms = 0;
-  std::int64_t next_report_ms = 0;
+  std::int64_t standing_at_end_ms = 0;
   bool radio_blocked = false;
   bool position_lost = false;
+  bool was_position_lost = false;
+  std::int64_t odometry_stopped_ms = 0;  // standing with the odometry stopped (not at start-up)
   // ground view
   bool abnormal = false;
   std::optional<std::int64_t> ground_limit;
@@ -121,6 +144,9 @@ struct TrainRt {
   double start_m = 0.0;
   double max_speed = 0.0;
   std::uint32_t emergency_brakes = 0;
+  std::uint32_t service_brakes = 0;
+  double max_lead_m = 0.0;     // most the unit's nominal front led the true front
+  double max_outside_m = 0.0;  // most the true front lay outside the unit's envelope
   std::size_t stops_made = 0;
   std::int64_t standstill_no_authority_ms = 0;
   std::uint64_t reports_sent = 0;
@@ -132,6 +158,7 @@ struct TrainRt {
   [[nodiscard]] double Rear() const { return motion.position - spec.performance.length_m; }
   [[nodiscard]] std::int64_t FrontMm() const { return ToMm(motion.position); }
   [[nodiscard]] std::int64_t RearMm() const { return FrontMm() - length_mm; }
+  [[nodiscard]] const units::OnboardOutputs* Out() const { return unit ? &unit->Outputs() : nullptr; }
 };
 
 struct CheckCount {
@@ -169,6 +196,23 @@ struct DirStats {
   std::uint64_t malformed = 0;
 };
 
+// A level crossing's equipment (lights and barriers) as the wayside unit drives it, and the
+// true state the crossing invariants read.
+struct CrossingRt {
+  std::uint32_t id = 0;
+  std::string name;
+  std::int64_t near_mm = 0;
+  std::int64_t far_mm = 0;
+  std::int64_t warning_time_ms = 0;
+  std::optional<std::int64_t> lights_since;    // lights on since
+  std::optional<std::int64_t> command_since;   // barriers commanded down since
+  bool down = false;                           // barriers detected down
+  std::uint64_t warnings = 0;
+  std::uint64_t passages = 0;
+  double shortest_warning_s = std::numeric_limits<double>::infinity();
+  std::set<std::uint16_t> occupying;
+};
+
 }  // namespace internal
 
 using namespace internal;  // NOLINT(google-build-using-namespace): the private header of this module
@@ -176,13 +220,17 @@ using namespace internal;  // NOLINT(google-build-using-namespace): the private 
 struct Simulation::Impl {
   Scenario sc;
   Line line;
+  std::vector<TrainType> types;
   const RunningLine* rl = nullptr;
   GroundLine gl;
-  std::unique_ptr<mb::wayside::Ground> ground;
+  OnboardLine obl;
+  std::unique_ptr<units::WaysideUnit> wayside;
   Channel channel;
-  Prng odo_prng;
   std::vector<std::unique_ptr<TrainRt>> trains;
   std::vector<FaultRt> faults;
+  std::vector<CrossingRt> crossings;
+  std::vector<std::string> train_data_findings;
+  std::vector<units::CrossingSensors> crossing_inputs;
   std::vector<bool> points_running_reverse;  // position of the running line's route
   std::vector<bool> points_reverse;
   std::int64_t now = 0;
@@ -195,6 +243,7 @@ struct Simulation::Impl {
   DirStats down;
   std::map<std::string, std::uint64_t> report_status;
   std::map<std::string, std::uint64_t> verdicts;
+  std::map<std::string, std::uint64_t> brake_reasons;  // on-board demands other than NONE, by reason
   std::uint64_t ground_cycles = 0;
   std::uint64_t telegrams_issued = 0;
   std::uint64_t events = 0;
@@ -203,19 +252,27 @@ struct Simulation::Impl {
   // gap measurement
   std::size_t gap_n = 0;
   double gap_sum = 0.0;
+  double gap_sq = 0.0;
   double gap_min = std::numeric_limits<double>::infinity();
   double gap_max = -std::numeric_limits<double>::infinity();
   double gap_vl = 0.0;
   double gap_vf = 0.0;
+  // per sample: t s, gap m, the follower's speed km/h and permitted speed km/h, then the gap's
+  // parts (m): its limit to its supervised front, the leader's rear to its limit, its supervised
+  // front to its true front
+  std::vector<std::array<double, 7>> gap_series;
   // log
   const RunOptions* opts = nullptr;
   bool first_event = true;
 
-  Impl(Scenario s, Line l)
-      : sc(std::move(s)), line(std::move(l)), channel(ChannelConfig{}, 0), odo_prng(0) {}
+  Impl(Scenario s, Line l, std::vector<TrainType> t)
+      : sc(std::move(s)), line(std::move(l)), types(std::move(t)), channel(ChannelConfig{}, 0) {}
 
   // ---- setup, the step, the event log and violation records (simulation.cpp)
   void Setup();
+  void SetupOnboardLine();
+  void SetupWayside();
+  [[nodiscard]] const mb::wayside::Ground& Ground() const { return wayside->Ground(); }
   // Writes one event to the log (if any), stamped with the time.
   void Emit(Json ev);
   // The log takes every accepted report and stop-limit telegram too.
@@ -234,39 +291,30 @@ struct Simulation::Impl {
   void ApplySchedule();
   [[nodiscard]] std::int64_t SidingRoute(const FaultSpec& s) const;
 
-  // ---- telegrams between the trains and the ground, the ground cycle (simulation_radio.cpp)
-  // Frames due now: a position report to the ground, a stop-limit telegram to the train.
+  // ---- frames between the units, the ground cycle, the crossings (simulation_radio.cpp)
+  // Frames due now: a train's telegram to the wayside unit, the unit's to the train's inbox.
   void DeliverFrames();
-  // The payload of a frame its endpoint accepts (counted per direction); a rejected frame is
-  // counted and logged (nullopt). A train's endpoint also updates the train's link state.
-  std::optional<std::span<const std::uint8_t>> Accept(tg::Endpoint& ep, TrainRt& t, const Frame& f, bool uplink,
-                                                      std::span<std::uint8_t> buffer);
-  void OnPositionReport(TrainRt& t, const Frame& f, std::span<const std::uint8_t> payload);
-  void OnStopLimit(TrainRt& t, std::span<const std::uint8_t> payload);
-  [[nodiscard]] std::int64_t ToFront(const messages::PositionReport& r) const;
-  // Canonical block + offset: the block holding front - 1 (block 0 for front 0).
-  [[nodiscard]] std::pair<std::uint32_t, std::int64_t> Locate(std::int64_t front_mm) const;
   void GroundCycle();
-  void SendReports();
+  void CrossingEquipment(const units::CycleOutput& out);
 
-  // ---- entry and exit, driving, dynamics and odometry (simulation_trains.cpp)
+  // ---- entry and exit, the on-board unit, the driver, motion and sensors (simulation_trains.cpp)
   // Length-weighted mean gradient (per mille) under the train [rear, front] (its physics).
   [[nodiscard]] double MeanGradient(double rear_m, double front_m) const;
-  // Steepest falling gradient (per mille, >= 0) over [a, b].
-  [[nodiscard]] double SteepestFall(double a_m, double b_m) const;
-  [[nodiscard]] std::int64_t CorrectionMm(const TrainRt& t) const;
   bool EntryClear(const TrainRt& n) const;
+  void CreateUnit(TrainRt& t, std::int64_t front_mm);
   void Enter(TrainRt& t);
   void Exit(TrainRt& t, const std::string& why);
-  // Highest speed the line's speed limits and the held speed restrictions allow at the
-  // next step (braking curves to lower limits ahead with deceleration b).
-  [[nodiscard]] double LineSpeed(const TrainRt& t, double safe_front, double rear, double b, double look) const;
-  Control Drive(TrainRt& t, double dt);
+  // The sensor data of the cycle that ends at `end_ms` for a motion from `start` with `accel`.
+  void Sense(TrainRt& t, std::int64_t end_ms, const Motion& start, double accel);
+  void OnboardCycle(TrainRt& t);
+  Control Drive(TrainRt& t, const units::OnboardOutputs& o, double dt);
+  double Apply(TrainRt& t, const Control& c, double gradient, double dt) const;
   void EnterTrains();
   void MoveTrains();
 
   // ---- the safety invariants (simulation_invariants.cpp)
   void CheckInvariants();
+  void CheckCrossings(const std::vector<const TrainRt*>& on);
 
   // ---- measurements (simulation_summary.cpp)
   void Measure();

@@ -16,7 +16,7 @@ void Simulation::Impl::ApplySchedule() {
         case FaultType::kRadioLoss:
         case FaultType::kTrackingLoss: ev["train"] = *s.train; break;
         case FaultType::kPossession: {
-          const auto r = ground->RequestPossession(core::Section{s.begin_mm, s.end_mm});
+          const auto r = wayside->RequestPossession(core::Section{s.begin_mm, s.end_mm});
           f.possession_id = r.id;
           f.status = mb::wayside::ToString(r.status);
           ev["possession"] = r.id;
@@ -26,7 +26,7 @@ void Simulation::Impl::ApplySchedule() {
           break;
         }
         case FaultType::kSidingRequest: {
-          const auto st = ground->RequestRoute(static_cast<std::uint32_t>(SidingRoute(s)));
+          const auto st = wayside->RequestRoute(static_cast<std::uint32_t>(SidingRoute(s)));
           f.status = mb::wayside::ToString(st);
           ev["route"] = SidingRoute(s);
           ev["status"] = f.status;
@@ -36,9 +36,9 @@ void Simulation::Impl::ApplySchedule() {
         }
         case FaultType::kSpeedRestriction: {
           const auto speed = static_cast<std::int64_t>(std::llround(s.speed_mps * 1000.0));
-          const auto r = ground->RequestSpeedRestriction(core::Section{s.begin_mm, s.end_mm}, speed);
+          const auto r = wayside->RequestSpeedRestriction(core::Section{s.begin_mm, s.end_mm}, speed);
           f.restriction_id = r.id;
-          const auto c = ground->ConfirmSpeedRestriction(r.id);
+          const auto c = wayside->ConfirmSpeedRestriction(r.id);
           f.status = std::string(mb::wayside::ToString(r.status)) + "/" + mb::wayside::ToString(c);
           ev["restriction"] = r.id;
           ev["range_mm"] = {s.begin_mm, s.end_mm};
@@ -57,18 +57,18 @@ void Simulation::Impl::ApplySchedule() {
         case FaultType::kRadioLoss:
         case FaultType::kTrackingLoss: ev["train"] = *s.train; break;
         case FaultType::kPossession:
-          ev["status"] = mb::wayside::ToString(ground->CancelPossession(f.possession_id));
+          ev["status"] = mb::wayside::ToString(wayside->CancelPossession(f.possession_id));
           ev["possession"] = f.possession_id;
           break;
         case FaultType::kSidingRequest: f.free_pending = true; break;
         case FaultType::kSpeedRestriction:
-          ev["status"] = mb::wayside::ToString(ground->CancelSpeedRestriction(f.restriction_id));
+          ev["status"] = mb::wayside::ToString(wayside->CancelSpeedRestriction(f.restriction_id));
           break;
       }
       Emit(ev);
     }
     if (f.free_pending) {
-      const auto st = ground->FreeRoute(static_cast<std::uint32_t>(SidingRoute(s)));
+      const auto st = wayside->FreeRoute(static_cast<std::uint32_t>(SidingRoute(s)));
       if (st == mb::wayside::CommandStatus::kAccepted) {
         f.free_pending = false;
         f.freed_at = now;

@@ -25,6 +25,16 @@ void Simulation::Impl::Measure() {
       f.moving_again_at = now;
     }
   }
+  for (auto& t : trains) {
+    const units::OnboardOutputs* o = t->Out();
+    if (!t->OnLine() || o == nullptr || !o->position_valid) {
+      continue;
+    }
+    const double nominal = ToM(o->front_mm);
+    t->max_lead_m = std::max(t->max_lead_m, nominal - t->motion.position);
+    t->max_outside_m = std::max({t->max_outside_m, t->motion.position - ToM(o->front_mm + o->front_error_mm),
+                                 ToM(o->front_mm - o->rear_error_mm) - t->motion.position});
+  }
   if (sc.gap && now >= sc.gap->from_ms && now <= sc.gap->to_ms) {
     const TrainRt* l = Find(sc.gap->leader);
     const TrainRt* f = Find(sc.gap->follower);
@@ -32,10 +42,22 @@ void Simulation::Impl::Measure() {
       const double gap = l->Rear() - f->motion.position;
       ++gap_n;
       gap_sum += gap;
+      gap_sq += gap * gap;
       gap_min = std::min(gap_min, gap);
       gap_max = std::max(gap_max, gap);
       gap_vl += l->motion.speed;
       gap_vf += f->motion.speed;
+      if (now % sc.sample_ms == 0) {
+        // the gap in three parts: leader's rear to the follower's limit (margin, the leader's
+        // reported envelope, the report's age), the limit to the follower's supervised front
+        // (the pattern the follower rides), and the supervised front to the true front
+        const units::OnboardOutputs& fo = *f->Out();
+        const double supervised = ToM(fo.front_mm + fo.front_error_mm);
+        const double limit = fo.indications.limit_mm ? ToM(*fo.indications.limit_mm) : std::nan("");
+        gap_series.push_back({ToS(now), R1(gap), R1(f->motion.speed * 3.6),
+                              R1(static_cast<double>(fo.indications.permitted_speed_mm_s) * 0.0036),
+                              R1(limit - supervised), R1(l->Rear() - limit), R1(supervised - f->motion.position)});
+      }
     }
   }
   if (now % sc.sample_ms == 0) {
@@ -43,8 +65,9 @@ void Simulation::Impl::Measure() {
       if (!t->OnLine()) {
         continue;
       }
-      const auto lim = t->auth.Limit();
-      const bool usable = lim && t->auth.Usable(now);
+      const units::OnboardOutputs& o = *t->Out();
+      const auto lim = o.authority_limit_mm;
+      const bool usable = lim && o.authority_usable;
       t->samples.push_back(Sample{now, t->motion.position, t->Rear(), usable ? ToM(*lim) : std::nan("")});
     }
   }
@@ -65,6 +88,7 @@ std::optional<GapResult> Simulation::Gap() const {
   g.mean_m = s.gap_sum / n;
   g.min_m = s.gap_min;
   g.max_m = s.gap_max;
+  g.std_m = std::sqrt(std::max(0.0, s.gap_sq / n - g.mean_m * g.mean_m));
   g.leader_speed_kmh = s.gap_vl / n * 3.6;
   g.follower_speed_kmh = s.gap_vf / n * 3.6;
   return g;
@@ -89,10 +113,15 @@ nlohmann::ordered_json Simulation::Summary() const {
                       {"min_delay_ms", s.sc.channel.min_delay_ms},
                       {"max_delay_ms", s.sc.channel.max_delay_ms},
                       {"corrupt_probability", s.sc.channel.corrupt_probability}};
+  // the supervision is the on-board unit's (br::PatternCalculator with the train type's data and
+  // spec/parameters/br.yaml); the scenario's former stand-in values are no longer used
   j["supervision"] = Json{{"margin_m", s.sc.supervision.margin_m},
                           {"free_running_s", s.sc.supervision.free_running_s},
                           {"emergency_free_running_s", s.sc.supervision.emergency_free_running_s},
-                          {"limit_tolerance_m", kLimitToleranceM}};
+                          {"limit_tolerance_m", kLimitToleranceM},
+                          {"by", "on-board unit (br patterns)"},
+                          {"cycle_ms", params::br::cycle_ms},
+                          {"service_offset_m", ToM(params::br::service_offset_mm)}};
   std::uint64_t nviol = 0;
   for (const auto& [id, c] : s.checks) {
     nviol += c.violations;
@@ -155,6 +184,10 @@ nlohmann::ordered_json Simulation::Summary() const {
                           {"max_speed_kmh", R1(t->max_speed * 3.6)},
                           {"stops_made", t->stops_made},
                           {"emergency_brakes", t->emergency_brakes},
+                          {"service_brakes", t->service_brakes},
+                          {"nominal_front_max_lead_m", R2(t->max_lead_m)},
+                          {"true_front_max_outside_envelope_m", R2(t->max_outside_m)},
+                          {"train_type", t->type->name},
                           {"standstill_without_authority_s", ToS(t->standstill_no_authority_ms)},
                           {"reports_sent", t->reports_sent},
                           {"reports_accepted", t->reports_accepted}});
@@ -187,7 +220,22 @@ nlohmann::ordered_json Simulation::Summary() const {
                      {"stop_limit_telegrams", s.telegrams_issued},
                      {"reports", rs},
                      {"tracking_abnormal_events", s.abnormal_events}};
-  j["onboard"] = Json{{"stop_limit_verdicts", vs}};
+  Json br = Json::object();
+  for (const auto& [k, v] : s.brake_reasons) {
+    br[k] = v;
+  }
+  j["onboard"] = Json{{"stop_limit_verdicts", vs}, {"brake_demand_cycles", br}};
+  Json xs = Json::array();
+  for (const auto& x : s.crossings) {
+    xs.push_back(Json{{"crossing", x.name},
+                      {"warning_time_s", ToS(x.warning_time_ms)},
+                      {"warnings", x.warnings},
+                      {"passages", x.passages},
+                      {"shortest_warning_before_passage_s",
+                       x.passages > 0 ? Json(R1(x.shortest_warning_s)) : Json(nullptr)}});
+  }
+  j["crossings"] = xs;
+  j["train_data_findings"] = s.train_data_findings;
   const auto after = [](const std::optional<std::int64_t>& at, std::int64_t ref) {
     return at ? Json(ToS(*at - ref)) : Json(nullptr);
   };
@@ -231,6 +279,10 @@ nlohmann::ordered_json Simulation::Summary() const {
                     {"settled_gap_m", R1(g->mean_m)},
                     {"min_m", R1(g->min_m)},
                     {"max_m", R1(g->max_m)},
+                    {"std_m", R1(g->std_m)},
+                    {"series_columns", {"t_s", "gap_m", "follower_kmh", "permitted_kmh", "limit_to_supervised_front_m",
+                                        "leader_rear_to_limit_m", "supervised_to_true_front_m"}},
+                    {"series", s.gap_series},
                     {"leader_speed_kmh", R1(g->leader_speed_kmh)},
                     {"follower_speed_kmh", R1(g->follower_speed_kmh)}};
   } else {

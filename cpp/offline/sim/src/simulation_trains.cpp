@@ -1,14 +1,17 @@
-// Line scenario simulation: the trains: entry and exit, driving (line speed, supervision
-// stand-in, station stops), the train-motion model (dynamics.hpp) and odometry
+// Line scenario simulation: the trains: entry and exit, the on-board unit's cycle, the driver
+// and the brake equipment, the true motion (dynamics.hpp) and the sensors (sensors.hpp)
 // (simulation_impl.hpp).
 #include "simulation_impl.hpp"
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
 #include <string>
+#include <utility>
+
+#include "railproof/generated/ra_params.hpp"
+#include "railproof/lc/onboard/crossing_protection.hpp"
 
 namespace railproof::sim {
 
@@ -26,23 +29,6 @@ double Simulation::Impl::MeanGradient(double rear_m, double front_m) const {
   return b > a ? sum / static_cast<double>(b - a) : static_cast<double>(rl->GradientAt(a)) / 10.0;
 }
 
-double Simulation::Impl::SteepestFall(double a_m, double b_m) const {
-  const std::int64_t a = ToMm(a_m);
-  const std::int64_t b = std::max(a + 1, ToMm(b_m));
-  double fall = 0.0;
-  for (const auto& g : rl->gradients) {
-    if (g.section.begin_mm < b && a < g.section.end_mm) {
-      fall = std::max(fall, -static_cast<double>(g.permille_x10) / 10.0);
-    }
-  }
-  return fall;
-}
-
-std::int64_t Simulation::Impl::CorrectionMm(const TrainRt& t) const {
-  const double odo_m = std::max(0.0, t.est_front_m - t.balise_est_m);
-  return static_cast<std::int64_t>(std::ceil(odo_m * 1000.0 * static_cast<double>(mbp::length_correction_ppm) / 1e6));
-}
-
 bool Simulation::Impl::EntryClear(const TrainRt& n) const {
   const std::int64_t front = n.spec.initial_front_mm;
   const std::int64_t rear = front - n.length_mm;
@@ -55,11 +41,11 @@ bool Simulation::Impl::EntryClear(const TrainRt& n) const {
       return false;
     }
     if (u->FrontMm() <= front) {
-      const auto prot = ground->ProtectedAuthority(u->spec.id);
+      const auto prot = Ground().ProtectedAuthority(u->spec.id);
       if (prot && *prot > rear - m) {
         return false;
       }
-      const auto lim = u->auth.Limit();
+      const auto lim = u->Out() != nullptr ? u->Out()->authority_limit_mm : std::nullopt;
       if (lim && *lim > rear - m) {
         return false;
       }
@@ -68,39 +54,73 @@ bool Simulation::Impl::EntryClear(const TrainRt& n) const {
   return true;
 }
 
-void Simulation::Impl::Enter(TrainRt& t) {
-  const mb::wayside::TrainRegistration reg{t.spec.id, t.length_mm, t.spec.initial_front_mm, 0,
-                                       mb::wayside::InitialPosition::kEntryBalise};
-  const auto st = ground->RegisterTrain(reg);
-  if (st != mb::wayside::RegisterStatus::kRegistered) {
-    throw InputError(sc.file + ": " + t.spec.entry + ": the ground refuses the train registration (status " +
-                     std::to_string(static_cast<int>(st)) + ")");
+// The on-board unit of a train starting (or restarting) with its front at `front_mm` (the
+// entry balise's fix): the train type's braking data, the odometry on the line's sections, the
+// track database, the crossing protection and the radio link to the wayside unit.
+void Simulation::Impl::CreateUnit(TrainRt& t, std::int64_t front_mm) {
+  units::OnboardConfig c;
+  c.train_id = t.spec.id;
+  c.train = ToTrainData(*t.type);
+  c.odometry.length_correction_ppm = mbp::length_correction_ppm;
+  // Ta never below gravity on the steepest gradient plus the sensors' acceleration errors
+  // (spec/design/ra.md §4, ASM-028): the sensor model puts gravity into the IMU's a_x.
+  std::int32_t steepest_x10 = 0;
+  for (const auto& s : obl.sections) {
+    steepest_x10 = std::max(steepest_x10, s.gradient_permille_x10);
   }
-  auto tc = tg::DeploymentConfig(tg::Role::kTrain, t.spec.id, kGroundId);
-  auto gc = tg::DeploymentConfig(tg::Role::kGround, kGroundId, t.spec.id);
-  if (t.train_ep.Init(tc, *t.key) != tg::ConfigError::kNone || t.ground_ep.Init(gc, *t.key) != tg::ConfigError::kNone) {
-    throw std::runtime_error("radio endpoint initialisation failed (crypto unavailable?)");
+  const std::int64_t floor_mm_s2 = (params::ra::gravity_mm_s2 * steepest_x10 + 9999) / 10000 +
+                                   params::ra::tg_accel_error_mm_s2 + params::ra::imu_accel_error_mm_s2;
+  c.odometry.detect_threshold_mm_s2 = std::max(c.odometry.detect_threshold_mm_s2, floor_mm_s2);
+  c.initial_front_mm = front_mm;
+  c.line = units::LineData{obl.blocks_mm, obl.gradients, t.limits, obl.balises, obl.crossings, obl.sections};
+  c.crossing = lc::onboard::DefaultProtectionConfig(t.spec.id, t.length_mm, c.train.accel_max_mm_s2);
+  c.radio = tg::DeploymentConfig(tg::Role::kTrain, t.spec.id, kGroundId);
+  c.link_key.emplace(t.key);
+  c.radio_period_ms = sc.report_period_ms;
+  // spread the trains' telegrams over the period
+  c.radio_offset_ms = (static_cast<std::int64_t>(t.spec.id) * sc.step_ms) % sc.report_period_ms;
+  auto created = units::OnboardUnit::Create(c);
+  if (created.check.error != units::OnboardConfigError::kNone) {
+    throw InputError(sc.file + ": " + t.spec.entry + ": the on-board unit refuses its configuration: " +
+                     units::ToString(created.check.error) + " (entry " + std::to_string(created.check.entry) + ")");
+  }
+  t.unit = std::make_unique<units::OnboardUnit>(std::move(*created.unit));
+  SensorConfig s;
+  s.length_correction_ppm = mbp::length_correction_ppm;
+  s.nominal_wheel_diameter_um = c.odometry.wheel_diameter_um;
+  s.seed = sc.seed ^ (0x5E5E5E5E00000000ULL + t.spec.id * 0x9E3779B97F4A7C15ULL);
+  t.sensors = std::make_unique<SensorModel>(s);
+  t.inbox.clear();
+  t.driver = {};
+  t.next_balise.reset();
+  t.next_balise_index = 0;
+  while (t.next_balise_index < rl->balises.size() && rl->balises[t.next_balise_index].position_mm <= front_mm) {
+    ++t.next_balise_index;
+  }
+  Sense(t, now, t.motion, 0.0);
+}
+
+void Simulation::Impl::Enter(TrainRt& t) {
+  const auto admitted = wayside->Admit(t.spec.id, t.spec.id);
+  const mb::wayside::TrainRegistration reg{t.spec.id, t.length_mm, t.spec.initial_front_mm, 0,
+                                           mb::wayside::InitialPosition::kEntryBalise};
+  const auto st = admitted == units::AdmitStatus::kAdmitted ? wayside->Register(reg) : units::RegisterResult{};
+  if (admitted != units::AdmitStatus::kAdmitted || st.status != units::RegisterStatus::kRegistered) {
+    throw InputError(sc.file + ": " + t.spec.entry + ": the wayside unit refuses the train (" +
+                     units::ToString(admitted) + ", " + units::ToString(st.status) + ", ground " +
+                     std::to_string(static_cast<int>(st.ground)) + ")");
   }
   t.phase = Phase::kStanding;
   t.entered_ms = now;
   t.motion = Motion{ToM(t.spec.initial_front_mm), 0.0};
-  t.est_front_m = t.motion.position;
-  t.balise_est_m = t.est_front_m;
-  t.balise_true_m = t.motion.position;
-  t.last_balise_mm = t.spec.initial_front_mm;
-  t.odo_error = -kOdometryErrorShare * static_cast<double>(mbp::length_correction_ppm) / 1e6 * odo_prng.Uniform();
-  t.next_balise = 0;
-  while (t.next_balise < rl->balises.size() && rl->balises[t.next_balise].position_mm <= t.spec.initial_front_mm) {
-    ++t.next_balise;
-  }
   t.start_m = t.motion.position;
-  // spread the report instants of the trains over the period
-  t.next_report_ms = now + (static_cast<std::int64_t>(t.spec.id) * sc.step_ms) % sc.report_period_ms;
-  Emit(Json{{"ev", "enter"}, {"train", t.spec.id}, {"front_mm", t.spec.initial_front_mm}, {"length_mm", t.length_mm}});
+  CreateUnit(t, t.spec.initial_front_mm);
+  Emit(Json{{"ev", "enter"}, {"train", t.spec.id}, {"front_mm", t.spec.initial_front_mm}, {"length_mm", t.length_mm},
+            {"train_type", t.type->name}});
 }
 
 void Simulation::Impl::Exit(TrainRt& t, const std::string& why) {
-  ground->RemoveTrain(t.spec.id);
+  (void)wayside->Remove(t.spec.id);
   channel.Purge(t.spec.id);
   t.phase = Phase::kExited;
   t.exited_ms = now;
@@ -108,102 +128,207 @@ void Simulation::Impl::Exit(TrainRt& t, const std::string& why) {
   Emit(Json{{"ev", "exit"}, {"train", t.spec.id}, {"front_mm", t.FrontMm()}, {"reason", why}});
 }
 
-double Simulation::Impl::LineSpeed(const TrainRt& t, double safe_front, double rear, double b, double look) const {
-  double v = std::numeric_limits<double>::infinity();
-  const double front = safe_front + look;
-  const auto limit_mps = [](const SpeedLimit& s) { return static_cast<double>(s.kmh) / 3.6; };
-  rl->ForEachLimitActing(rear, front, [&](std::size_t i) { v = std::min(v, limit_mps(rl->speed_limits[i])); }, 1000.0);
-  for (const auto& s : rl->speed_limits) {
-    const double begin = ToM(s.section.begin_mm);
-    if (begin > front) {  // ahead: the speed from which braking with b reaches the limit at its begin
-      v = std::min(v, SpeedAfter(limit_mps(s), b, begin - front));
-    }
-  }
-  const auto front_mm = ToMm(t.est_front_m);
-  if (const auto tsr = t.tsr.ApplicableSpeed(front_mm, t.length_mm)) {
-    v = std::min(v, static_cast<double>(*tsr) / 1000.0);
-  }
-  for (const auto& r : t.tsr.Held()) {
-    const double begin = ToM(r.begin_mm);
-    const double lim = static_cast<double>(r.speed_mm_s) / 1000.0;
-    if (begin >= front) {
-      v = std::min(v, SpeedAfter(lim, b, begin - front));
-    } else if (rear < ToM(r.end_mm)) {
-      v = std::min(v, lim);
-    }
-  }
-  return v;
+void Simulation::Impl::Sense(TrainRt& t, std::int64_t end_ms, const Motion& start, double accel) {
+  TrueCycle c;
+  c.time_ms = end_ms;
+  c.start = start;
+  c.accel_mps2 = accel;
+  c.gradient_permille = MeanGradient(start.position - t.spec.performance.length_m, start.position);
+  t.next_sensors = t.sensors->Cycle(c);
 }
 
-Control Simulation::Impl::Drive(TrainRt& t, double dt) {
+// One cycle of the train's on-board unit with what reached it since the last one; its
+// telegram goes to the channel.
+void Simulation::Impl::OnboardCycle(TrainRt& t) {
+  std::vector<std::span<const std::uint8_t>> frames(t.inbox.begin(), t.inbox.end());
+  units::OnboardInputs in;
+  in.now_ms = now;
+  in.sensors = t.next_sensors;
+  if (t.position_lost) {
+    in.sensors.imu_count = 0;  // the injected sensor failure: the odometry stops (REQ-RA-013)
+  }
+  in.balise_id = std::exchange(t.next_balise, std::nullopt);
+  in.frames = frames;
+  in.driver = t.driver;
+  if (t.phase == Phase::kDwelling) {
+    in.dwell_departure_ms = t.dwell_until_ms;
+  }
+  const auto before_limit = t.Out() != nullptr ? t.Out()->authority_limit_mm : std::nullopt;
+  const auto before_kind = t.Out() != nullptr ? t.Out()->indications.obstruction : messages::Obstruction::kNone;
+  const auto before_governs = t.Out() != nullptr ? t.Out()->indications.limit_kind : units::LimitKind::kNone;
+  const auto last_reason = t.Out() != nullptr ? t.Out()->reason : units::BrakeReason::kNone;
+  const auto last_mode = t.unit->Odometry().mode;
+  const units::OnboardOutputs& o = t.unit->Cycle(in);
+  t.inbox.clear();
+  for (const units::RxEvent& e : o.Events()) {
+    switch (e.status) {
+      case units::RxStatus::kFrameRejected:
+        ++down.rejected[tg::ToString(e.reject)];
+        Emit(Json{{"ev", "telegram_rejected"}, {"dir", "down"}, {"train", t.spec.id}, {"reason", tg::ToString(e.reject)}});
+        break;
+      case units::RxStatus::kUndecodable:
+      case units::RxStatus::kOtherTrain:
+      case units::RxStatus::kUnexpectedType: ++down.malformed; break;
+      case units::RxStatus::kAccepted:
+      case units::RxStatus::kStopLimitRefused:
+        down.accepted += e.entry == 0 ? 1U : 0U;
+        if (e.type == messages::MessageType::kStopLimit) {
+          ++verdicts[mb::onboard::ToString(e.verdict)];
+        }
+        break;
+      case units::RxStatus::kMessageDropped:
+      case units::RxStatus::kFramesDropped: ++down.malformed; break;
+    }
+  }
+  if (o.sent) {
+    ++t.reports_sent;
+    exercised.insert("REQ-MB-001");
+    channel.Send(t.spec.id, Direction::kUplink, now, o.frame.View(), t.radio_blocked);
+  }
+  const auto lim = o.authority_limit_mm;
+  if (lim && (!before_limit || *lim < *before_limit || o.indications.obstruction != before_kind || Full())) {
+    Emit(Json{{"ev", "limit"}, {"train", t.spec.id}, {"limit_mm", *lim},
+              {"kind", messages::ToString(o.indications.obstruction)},
+              {"previous_mm", before_limit ? Json(*before_limit) : Json(nullptr)}});
+  }
+  if (o.brake != units::BrakeDemand::kNone) {
+    ++brake_reasons[units::ToString(o.reason)];
+  }
+  if (const ra::OdometryOutput& od = t.unit->Odometry(); od.mode != last_mode) {
+    Emit(Json{{"ev", "odometry"}, {"train", t.spec.id}, {"mode", ra::ToString(od.mode)},
+              {"stop_reason", ra::ToString(od.stop_reason)}, {"speed_mps", R2(t.motion.speed)},
+              {"front_error_m", R2(ToM(od.front_error_mm))}, {"rear_error_m", R2(ToM(od.rear_error_mm))},
+              {"nominal_lead_m", R2(ToM(od.front_mm) - t.motion.position)}, {"brake", static_cast<int>(t.brake)},
+              {"ax_avg", R2(od.ax_avg)}, {"ap_avg", R2(od.ap_avg)}});
+  }
+  if (o.reason != last_reason && o.reason != units::BrakeReason::kServicePattern &&
+      (o.reason != units::BrakeReason::kNone || last_reason != units::BrakeReason::kServicePattern)) {
+    const ra::OdometryOutput& od = t.unit->Odometry();
+    Emit(Json{{"ev", "brake_demand"}, {"train", t.spec.id}, {"demand", units::ToString(o.brake)},
+              {"reason", units::ToString(o.reason)}, {"odometry", ra::ToString(od.mode)},
+              {"odometry_stop", ra::ToString(od.stop_reason)}, {"speed_mps", R2(t.motion.speed)}});
+  }
+  if (o.indications.limit_kind != before_governs) {
+    Emit(Json{{"ev", "governing_limit"}, {"train", t.spec.id}, {"kind", units::ToString(o.indications.limit_kind)},
+              {"limit_mm", o.indications.limit_mm ? Json(*o.indications.limit_mm) : Json(nullptr)},
+              {"crossing", o.indications.crossing_id}, {"speed_mps", R2(t.motion.speed)}});
+  }
+  if (o.indications.limit_kind == units::LimitKind::kCrossingProtection) {
+    exercised.insert("REQ-LC-003");
+  }
+}
+
+namespace {
+
+// The service brake notch of a supervision level: 7N the full service brake, the mild brakes
+// 4N..6N the share of their notch (D5 §5.5: 4N-7N follow the pattern; the odometry's TG
+// cannot tell a notch from a slide, so the brake is applied as graded as the unit asks).
+double ServiceShare(br::BrakeLevel level) {
+  switch (level) {
+    case br::BrakeLevel::k4N: return 4.0 / 7.0;
+    case br::BrakeLevel::k5N: return 5.0 / 7.0;
+    case br::BrakeLevel::k6N: return 6.0 / 7.0;
+    default: return 1.0;
+  }
+}
+
+}  // namespace
+
+// The driver and the brake equipment. The unit's demand overrides the driver: SERVICE is the
+// service brake at the unit's notch (7N: full), EMERGENCY the emergency brake held until
+// standstill. Otherwise the driver
+// aims at the indicated permitted speed less a driving margin (no traction while "pattern
+// approaching" is shown), the scenario's speed cap and the station stop, and resets the
+// supervision's latched emergency brake at standstill once the authority is usable again.
+Control Simulation::Impl::Drive(TrainRt& t, const units::OnboardOutputs& o, double dt) {
   const TrainPerformance& p = t.spec.performance;
   const double v = t.motion.speed;
-  const double corr = ToM(CorrectionMm(t));
-  const double safe_front = t.est_front_m + corr;
-  const double rear = t.est_front_m - p.length_m - corr;
-  t.link_up = t.train_ep.Link() == tg::LinkState::kUp;
-  const bool usable = t.auth.Usable(now) && t.link_up;
+  const Brake prev = t.brake;
   Control c;
-  const auto limit_mm = t.auth.Limit();
-  if (!usable || !limit_mm) {
-    // no usable authority (none yet, expired, or radio link down): standstill demanded
-    if (!t.eb && v > 0.0) {
+  t.driver = {};
+  if (o.brake == units::BrakeDemand::kEmergency) {
+    if (!t.eb_hold && v > 0.0) {
       ++t.emergency_brakes;
       Emit(Json{{"ev", "emergency_brake"}, {"train", t.spec.id}, {"speed_mps", R2(v)},
-                {"reason", !t.link_up ? "radio link not up" : "no usable authority"}});
-      exercised.insert("REQ-MB-009");
+                {"reason", units::ToString(o.reason)},
+                {"distance_to_limit_m", R2(ToM(o.indications.target_distance_mm))}});
     }
-    t.eb = true;
+    t.eb_hold = v > 0.0;
+  }
+  if (t.eb_hold && v <= 0.0) {
+    t.eb_hold = false;
+  }
+  if (t.eb_hold || o.brake == units::BrakeDemand::kEmergency) {
+    t.brake = Brake::kEmergency;
     c.emergency = true;
-    return c;
-  }
-  const double limit = ToM(*limit_mm);
-  const double d = limit - safe_front;
-  const double fall = SteepestFall(safe_front, std::max(safe_front, limit) + 1.0);
-  const double bs = std::max(0.05, p.service_decel_mps2 - GradeDecel(fall));
-  const double be = std::max(0.05, p.emergency_decel_mps2 - GradeDecel(fall));
-  const double v_e = CurveSpeed(d, be, sc.supervision.emergency_free_running_s);
-  if (v > v_e + 1e-9 && !t.eb) {
-    ++t.emergency_brakes;
-    t.eb = true;
-    Emit(Json{{"ev", "emergency_brake"}, {"train", t.spec.id}, {"speed_mps", R2(v)}, {"reason", "emergency curve exceeded"},
-              {"distance_to_limit_m", R2(d)}});
-  }
-  if (t.eb) {
-    if (v > 0.0) {
-      c.emergency = true;
-      return c;
+  } else if (o.brake == units::BrakeDemand::kService) {
+    t.brake = Brake::kService;
+    c.brake_mps2 = p.service_decel_mps2 * ServiceShare(o.level);
+    if (prev != Brake::kService) {
+      ++t.service_brakes;
     }
-    t.eb = false;  // standstill with a usable authority: released
+  } else {
+    t.brake = Brake::kNone;
   }
-  if (t.position_lost || t.phase == Phase::kStanding || t.phase == Phase::kDwelling) {
-    c.brake_mps2 = p.service_decel_mps2;  // hold / brake to a stop
+  if (v <= 0.0 && o.level == br::BrakeLevel::kEmergency && o.authority_usable && o.link == tg::LinkState::kUp) {
+    t.driver.handle_emergency = true;
+    t.driver.reset = true;
+  }
+  if (t.brake != Brake::kNone) {
     return c;
   }
-  // running: target speed for the end of this step
-  const double look = v * dt;
-  double target = std::min(p.max_speed_mps, t.spec.speed_cap_mps.value_or(p.max_speed_mps));
-  target = std::min(target, LineSpeed(t, safe_front, rear, bs, look));
-  target = std::min(target, CurveSpeed(d - sc.supervision.margin_m - look, bs, sc.supervision.free_running_s));
+  if (t.phase != Phase::kRunning || !o.position_valid) {
+    c.brake_mps2 = p.service_decel_mps2;  // standing, dwelling: the driver holds the train
+    return c;
+  }
+  const double look = v * (dt + kDriverResponseS);  // the driver anticipates his response
+  const double permitted = static_cast<double>(o.indications.permitted_speed_mm_s) / 1000.0;
+  double target = std::min({p.max_speed_mps, t.spec.speed_cap_mps.value_or(p.max_speed_mps),
+                            permitted - kDrivingMarginMps});
   if (t.next_stop < t.spec.stops.size()) {
     const Station* st = rl->FindStation(t.spec.stops[t.next_stop].station);
-    const double ds = ToM(st->stop_mm) - t.est_front_m;
-    const double vs = ds > 0.5 ? std::max(kCreepMps, CurveSpeed(ds - 0.3 - look, kStationDecelShare * bs, 0.0)) : 0.0;
+    const double ds = ToM(st->stop_mm - o.front_mm);
+    const double vs = ds > 0.5 ? std::max(kCreepMps, CurveSpeed(ds - 0.3 - look, kStationDecelShare * p.service_decel_mps2, 0.0))
+                               : 0.0;
     target = std::min(target, vs);
   }
   target = std::max(0.0, target);
-  if (target < 0.01 && v < 0.5) {
+  if (target < 0.5 * kCreepMps && v < kCreepMps) {  // nothing worth moving for: stop and hold
     c.brake_mps2 = p.service_decel_mps2;  // stopping or standing: full service brake holds the train
+    t.brake = Brake::kDriver;
     return c;
   }
   const double other = NetAcceleration(p, Control{}, v, MeanGradient(t.motion.position - p.length_m, t.motion.position));
-  const double need = (target - v) / dt - other;  // applied acceleration needed
+  const double need = (target - v) / kDriverResponseS - other;  // applied acceleration needed
   if (need > 0.0) {
     c.traction_mps2 = std::min(need, p.accel_mps2);
   } else {
     c.brake_mps2 = std::min(-need, p.service_decel_mps2);
+    t.brake = c.brake_mps2 > 0.0 ? Brake::kDriver : Brake::kNone;
   }
   return c;
+}
+
+// The traction and brake equipment: the applied acceleration (traction minus brake) follows the
+// command at no more than kApplyRateMps3 (traction control and brake build-up); a standing
+// train's holding brake is applied at once. Between the full service and the emergency brake
+// the net acceleration is interpolated between the two (the same resistance and gravity).
+double Simulation::Impl::Apply(TrainRt& t, const Control& c, double gradient, double dt) const {
+  const TrainPerformance& p = t.spec.performance;
+  const double wanted = c.emergency ? -p.emergency_decel_mps2
+                                    : std::min(c.traction_mps2, p.accel_mps2) - std::min(c.brake_mps2, p.service_decel_mps2);
+  const double step = kApplyRateMps3 * dt;
+  const bool holding = t.motion.speed <= 0.0 && wanted <= 0.0;
+  t.applied_mps2 = holding ? wanted : std::clamp(wanted, t.applied_mps2 - step, t.applied_mps2 + step);
+  const double v = t.motion.speed;
+  if (t.applied_mps2 >= -p.service_decel_mps2) {
+    return NetAcceleration(p, Control{std::max(t.applied_mps2, 0.0), std::max(-t.applied_mps2, 0.0), false}, v,
+                           gradient);
+  }
+  const double service = NetAcceleration(p, Control{0.0, p.service_decel_mps2, false}, v, gradient);
+  const double emergency = NetAcceleration(p, Control{0.0, 0.0, true}, v, gradient);
+  const double share = (-t.applied_mps2 - p.service_decel_mps2) / (p.emergency_decel_mps2 - p.service_decel_mps2);
+  return service + share * (emergency - service);
 }
 
 void Simulation::Impl::EnterTrains() {
@@ -241,55 +366,72 @@ void Simulation::Impl::MoveTrains() {
         continue;
       }
     }
-    const Control c = Drive(t, dt);
-    const double grad = MeanGradient(t.motion.position - t.spec.performance.length_m, t.motion.position);
-    const double a = NetAcceleration(t.spec.performance, c, t.motion.speed, grad);
-    const Motion before = t.motion;
-    t.motion = offline::Advance(before, a, dt);
-    const double moved = t.motion.position - before.position;
-    // odometry: under-reads by odo_error; a balise passed resets it
-    t.est_front_m += moved * (1.0 + t.odo_error);
-    while (t.next_balise < rl->balises.size() && ToMm(t.motion.position) >= rl->balises[t.next_balise].position_mm) {
-      const auto& b = rl->balises[t.next_balise];
-      const double beyond = t.motion.position - ToM(b.position_mm);
-      t.odo_error = -kOdometryErrorShare * static_cast<double>(mbp::length_correction_ppm) / 1e6 * odo_prng.Uniform();
-      t.balise_est_m = ToM(b.position_mm);
-      t.balise_true_m = ToM(b.position_mm);
-      t.est_front_m = std::max(t.est_front_m, t.balise_est_m + beyond * (1.0 + t.odo_error));
-      t.last_balise_mm = b.position_mm;
-      ++t.next_balise;
-      if (Full()) {
-        Emit(Json{{"ev", "balise"}, {"train", t.spec.id}, {"balise", b.id}});
-      }
+    // The re-fix after a tracking loss, or after the odometry stopped (it waits for a balise
+    // the standing train cannot reach): the unit restarts at the train's position and the
+    // train registers again (as at an entry balise, REQ-MB-016). A stand-in for the operating
+    // procedure (spec/design/sim.md).
+    const bool refix_due = t.odometry_stopped_ms >= kRefixAfterMs;
+    if ((t.was_position_lost && !t.position_lost && t.motion.speed <= 0.0) || refix_due) {
+      t.odometry_stopped_ms = 0;
+      (void)wayside->Remove(t.spec.id);
+      channel.Purge(t.spec.id);
+      (void)wayside->Admit(t.spec.id, t.spec.id);
+      const auto st = wayside->Register(mb::wayside::TrainRegistration{t.spec.id, t.length_mm, t.FrontMm(), 0,
+                                                                       mb::wayside::InitialPosition::kEntryBalise});
+      CreateUnit(t, t.FrontMm());
+      Emit(Json{{"ev", "refix"}, {"train", t.spec.id}, {"front_mm", t.FrontMm()},
+                {"status", units::ToString(st.status)}});
     }
+    t.was_position_lost = t.position_lost;
+    OnboardCycle(t);
+    const units::OnboardOutputs& o = *t.Out();
+    const bool stopped = t.unit->Odometry().mode == ra::Mode::kStopped &&
+                         t.unit->Odometry().stop_reason != ra::StopReason::kStartUp;
+    t.odometry_stopped_ms = stopped && !t.position_lost && t.motion.speed <= 0.0 ? t.odometry_stopped_ms + sc.step_ms : 0;
+    const Control c = Drive(t, o, dt);
+    const double grad = MeanGradient(t.Rear(), t.motion.position);
+    const double a = Apply(t, c, grad, dt);
+    const Motion before = t.motion;
+    t.previous_front_m = before.position;
+    t.motion = offline::Advance(before, a, dt);
+    // a balise the true front passed is read in the next cycle
+    while (t.next_balise_index < rl->balises.size() &&
+           t.FrontMm() >= rl->balises[t.next_balise_index].position_mm) {
+      t.next_balise = static_cast<std::uint32_t>(t.next_balise_index + 1);
+      if (Full()) {
+        Emit(Json{{"ev", "balise"}, {"train", t.spec.id}, {"balise", rl->balises[t.next_balise_index].id}});
+      }
+      ++t.next_balise_index;
+    }
+    Sense(t, now + sc.step_ms, before, a);
     t.max_speed = std::max(t.max_speed, t.motion.speed);
-    if (t.phase == Phase::kRunning && t.motion.speed <= 0.0 && (t.eb || !t.auth.Usable(now))) {
+    if (t.phase == Phase::kRunning && t.motion.speed <= 0.0 && !o.authority_usable) {
       t.standstill_no_authority_ms += sc.step_ms;
     }
-    // station arrival
+    // station arrival (the driver sees the unit's position)
     if (t.phase == Phase::kRunning && t.motion.speed <= 0.0 && t.next_stop < t.spec.stops.size()) {
       const Station* st = rl->FindStation(t.spec.stops[t.next_stop].station);
-      const double ds = ToM(st->stop_mm) - t.est_front_m;
+      const double ds = ToM(st->stop_mm - o.front_mm);
       if (ds <= kStopWindowM) {
         t.phase = Phase::kDwelling;
         t.dwell_until_ms = now + sc.step_ms + t.spec.stops[t.next_stop].dwell_ms;
         ++t.stops_made;
-        Emit(Json{{"ev", "arrive"}, {"train", t.spec.id}, {"station", st->name}, {"stop_error_m", R2(-ds)}});
+        Emit(Json{{"ev", "arrive"}, {"train", t.spec.id}, {"station", st->name},
+                  {"stop_error_m", R2(t.motion.position - ToM(st->stop_mm))}});
       }
     }
-    // beyond an accepted system boundary: handed over to the neighbour once its rear has
-    // passed the boundary (until then it obstructs like any train)
-    if (rl->system_boundary_mm && sc.boundary_accepted && t.RearMm() >= *rl->system_boundary_mm) {
-      Exit(t, "crossed the system boundary");
-      continue;
-    }
-    // end of the line: leaves the area (removed from the ground)
-    if (t.phase == Phase::kRunning && t.motion.speed <= 0.0 && t.next_stop >= t.spec.stops.size() &&
-        t.limit_kind == messages::Obstruction::kEndOfTrack && t.auth.Limit()) {
-      const double d = ToM(*t.auth.Limit()) - t.est_front_m - ToM(CorrectionMm(t));
-      if (d <= sc.supervision.margin_m + kExitWindowM) {
-        Exit(t, "end of line");
+    // end of the line: standing before the end of track (or a boundary no neighbour
+    // accepts) with no stop left, it leaves the area (removed from the wayside unit)
+    const auto kind = o.indications.obstruction;
+    const bool at_end = kind == messages::Obstruction::kEndOfTrack || kind == messages::Obstruction::kSystemBoundary;
+    if (t.phase == Phase::kRunning && t.motion.speed <= 0.0 && t.next_stop >= t.spec.stops.size() && at_end &&
+        o.indications.limit_mm && ToM(o.indications.target_distance_mm) <= kExitWindowM) {
+      t.standing_at_end_ms += sc.step_ms;
+      if (t.standing_at_end_ms >= 5000) {
+        Exit(t, kind == messages::Obstruction::kEndOfTrack ? "end of line" : "at the system boundary");
       }
+    } else {
+      t.standing_at_end_ms = 0;
     }
   }
 }

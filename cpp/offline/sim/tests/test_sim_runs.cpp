@@ -1,5 +1,8 @@
-// Scenario runs on the 10 km test line (data/sim_test_line.json): invariants hold, a
-// follower settles behind a slow leader, faults stop the trains they should stop.
+// Scenario runs of the system simulation on the 10 km test line (data/sim_test_line.json, one
+// level crossing) with the real on-board and wayside units: invariants hold on a lossy channel,
+// runs are deterministic, a follower settles behind a slow leader, faults stop the trains they
+// should stop, and the invariant checks fire on a seeded failure (a train whose brakes are
+// weaker than its unit's braking data).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -24,13 +27,34 @@ const Line& TestLine() {
   return line;
 }
 
+// The on-board data of the test's 100 m trains (the form of spec/trains/*.yaml).
+TrainType TestType() {
+  TrainType t;
+  t.name = "test100";
+  t.length_mm = 100'000;
+  t.max_speed_kmh = 100;
+  t.accel_max_mm_s2 = 800;
+  t.emergency_pattern_mm_s2 = 1000;
+  t.service_pattern_mm_s2 = 850;
+  t.emergency_free_running_ms = {500, 1500};
+  t.service_free_running_ms = {1000, 2500};
+  t.emergency_overspeed_kmh = 5;
+  t.speed_error_ppm = 2500;
+  t.speed_error_abs_mm_s = 174;
+  t.emergency_deceleration_mm_s2 = {1100, 1400};
+  t.service_deceleration_mm_s2 = {900, 1200};
+  t.odometry_ppm = 1000;
+  t.readhesion_margin_mm = 40'000;
+  return t;
+}
+
 nlohmann::json TrainJson(int id, double front_m, double depart_s) {
   return nlohmann::json{{"id", id},
                         {"length_m", 100},
                         {"max_speed_kmh", 100},
                         {"accel_mps2", 0.8},
-                        {"service_decel_mps2", 0.8},
-                        {"emergency_decel_mps2", 1.2},
+                        {"service_decel_mps2", 0.9},
+                        {"emergency_decel_mps2", 1.1},
                         {"initial_front_m", front_m},
                         {"depart_s", depart_s}};
 }
@@ -47,7 +71,9 @@ nlohmann::json ScenarioJson(double duration_s) {
                         {"trains", nlohmann::json::array()}};
 }
 
-Simulation Make(const nlohmann::json& j) { return Simulation(ParseScenario(j.dump(), "unit.json"), TestLine()); }
+Simulation Make(const nlohmann::json& j) {
+  return Simulation(ParseScenario(j.dump(), "unit.json"), TestLine(), {TestType()});
+}
 
 std::string Describe(const Simulation& sim) {
   std::string s;
@@ -133,8 +159,11 @@ TEST(SimRun, FollowerAtFullPowerSettlesBehindASlowLeader) {
   EXPECT_NEAR(g.leader_speed_kmh, 20.0, 0.5);
   EXPECT_GT(g.min_m, 20.0);  // never closer than the preceding-train margin
   EXPECT_LT(g.max_m - g.min_m, 30.0) << "gap did not settle: " << g.min_m << " .. " << g.max_m;
-  EXPECT_GT(g.mean_m, 40.0);
-  EXPECT_LT(g.mean_m, 120.0);
+  EXPECT_LT(g.std_m, 10.0);
+  // the patterns' distance at 20 km/h: the service offset, the run-up, the envelopes of both
+  // trains, the preceding-train margin and the report's age (spec/design/sim.md §6)
+  EXPECT_GT(g.mean_m, 80.0);
+  EXPECT_LT(g.mean_m, 250.0);
 }
 
 // @verifies REQ-MB-006
@@ -177,8 +206,8 @@ TEST(SimRun, TrackingLossMarksTheTrainAbnormalAndHoldsTheFollower) {
   j["trains"].push_back(TrainJson(3, 600, 0));
   j["faults"] = {{{"type", "tracking_loss"}, {"train", 2}, {"from_s", 90}, {"to_s", 150}}};
   Simulation sim = Make(j);
-  const TrainView leader = StandingAt(sim, 140'000, 2);
-  const TrainView follower = StandingAt(sim, 140'000, 3);
+  const TrainView leader = StandingAt(sim, 149'000, 2);
+  const TrainView follower = sim.Train(3).value_or(TrainView{});
   EXPECT_TRUE(leader.abnormal);
   // the follower stands at least the abnormal-train margin behind the leader's rear
   EXPECT_GT(leader.rear_m - follower.front_m, 50.0);
@@ -224,25 +253,38 @@ TEST(SimRun, SidingRouteRequestHoldsTrainsBeforeTheRouteEntrance) {
   EXPECT_GT(sim.Train(2)->front_m, 5100.0);
 }
 
-// Negative test of the invariant checker: a possession requested inside the braking
-// distance of a train running at line speed pulls its stop limit back to a point it
-// cannot stop before; the ASM-013 check must record it (once, as one episode) and the
-// possession must still never become active with the train inside (REQ-MB-014).
-TEST(SimRun, InvariantCheckerFlagsAnOverrunOfARetractedLimit) {
-  auto j = ScenarioJson(200);
+// Negative test of the invariant checks: a train whose brakes are weaker than the braking data
+// its on-board unit supervises with (service and emergency deceleration below the patterns')
+// cannot stop where the patterns say: it overruns its stop limit at the end of the line, and the
+// check must say so; the summary names the mismatch.
+TEST(SimRun, InvariantChecksFireOnATrainWithBrakesWeakerThanItsData) {
+  auto j = ScenarioJson(300);
   j["channel"] = {{"loss_probability", 0.0}, {"max_delay_ms", 100}};
-  j["trains"].push_back(TrainJson(2, 5200, 0));
-  j["faults"] = {{{"type", "possession"}, {"begin_m", 7000}, {"end_m", 7500}, {"from_s", 70}, {"to_s", 150}}};
+  auto t = TrainJson(2, 5200, 0);
+  t["service_decel_mps2"] = 0.3;
+  t["emergency_decel_mps2"] = 0.4;
+  j["trains"].push_back(t);
   Simulation sim = Make(j);
   sim.Run();
   const auto s = sim.Summary();
   EXPECT_EQ(s["result"], "FAIL");
-  EXPECT_EQ(s["checks"]["ASM-013"]["violations"], 1);
-  EXPECT_GT(s["checks"]["ASM-013"]["violation_steps"].get<int>(), 1);
-  EXPECT_EQ(s["checks"]["REQ-MB-014"]["violations"], 0);
+  EXPECT_GE(s["checks"]["ASM-013"]["violations"].get<int>(), 1);
   EXPECT_EQ(s["checks"]["REQ-MB-008"]["violations"], 0);
-  ASSERT_EQ(sim.Violations().size(), 1U);
-  EXPECT_EQ(sim.Violations()[0].requirement, "ASM-013");
+  EXPECT_EQ(s["train_data_findings"].size(), 2U);
+  ASSERT_FALSE(sim.Violations().empty());
+}
+
+// The same train with the brakes its data describe runs the same line without a violation.
+// @verifies REQ-BR-001
+// @verifies REQ-BR-004
+TEST(SimRun, TheSameTrainWithItsRealBrakesStopsInTime) {
+  auto j = ScenarioJson(300);
+  j["channel"] = {{"loss_probability", 0.0}, {"max_delay_ms", 100}};
+  j["trains"].push_back(TrainJson(2, 5200, 0));
+  Simulation sim = Make(j);
+  const auto s = RunWithoutViolations(sim);
+  EXPECT_TRUE(s["train_data_findings"].empty());
+  EXPECT_GT(sim.Train(2)->front_m, 9800.0);  // ran to the end of the line
 }
 
 TEST(SimRun, TrainsStopAtStationsAndLeaveAtTheTerminus) {

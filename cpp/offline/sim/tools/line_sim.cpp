@@ -1,11 +1,14 @@
-// line_sim: offline line scenario simulation (moving block, issue 3 item 6). Runs a
-// scenario (spec/scenarios/*.json) on a generated line (build/gen/lines/<line>.json) with
-// the runtime ground and on-board code, the radio telegram layer over a lossy channel and
-// injected faults; checks the safety invariants at every step. See spec/scenarios/README.md.
+// line_sim: offline system simulation of a line (simulation.hpp, spec/design/sim.md). Runs a
+// scenario (spec/scenarios/*.json) on a generated line (build/gen/lines/<line>.json) with the
+// real on-board units (train data of build/gen/trains/<type>.json) and the real wayside unit,
+// their telegrams over a lossy channel and injected faults; checks the safety invariants at
+// every step. See spec/scenarios/README.md.
 //
 // Exit status: 0 no invariant violated; 1 invariant violations; 2 bad usage or bad input
 // (cli.hpp).
+#include <algorithm>
 #include <chrono>
+#include <filesystem>
 #include <cstdio>
 #include <functional>
 #include <iostream>
@@ -39,6 +42,7 @@ void SetLeaderCap(railproof::sim::Scenario& sc, double kmh) {
 struct Options {
   std::string scenario;
   std::string lines_dir;
+  std::string trains_dir;
   std::string log;
   std::string svg;
   std::string summary;
@@ -52,15 +56,20 @@ Options ParseArgs(int argc, char** argv) {
   namespace off = railproof::offline;
   Options o;
   off::Cli cli("line_sim",
-               "Simulates a moving-block line scenario: trains with simple longitudinal dynamics, the\n"
-               "ground (tracking, interlocking, stop limits) and on-board authority handling, position\n"
-               "reports and stop-limit telegrams through the radio telegram layer over a lossy, delaying\n"
-               "channel, and injected faults. Safety invariants are checked after every step.\n"
+               "Simulates a line scenario: every train's true motion, its sensors, its on-board unit\n"
+               "(odometry, braking supervision, crossing protection, radio) and a driver; the wayside\n"
+               "unit (radio endpoints, moving-block ground, crossing controllers) and the crossings'\n"
+               "equipment; the units' telegrams over a lossy, delaying channel, and injected faults.\n"
+               "Safety invariants are checked after every step.\n"
                "Progress: one line per 10 % of simulated time on stderr.",
                "0 no invariant violated, 1 invariant violations");
   const CLI::Validator speed = off::InRange(0.0, 400.0, true);
   cli.Add("--scenario", o.scenario, "scenario (format: spec/scenarios/README.md)")->required();
   cli.Add("--lines-dir", o.lines_dir, "directory of generated line JSON files (<line>.json)")->required();
+  cli.Add("--trains-dir", o.trains_dir,
+          "directory of generated train-type JSON files (<type>.json): each train's on-board data is\n"
+          "the type of its length")
+      ->required();
   cli.Add("--log", o.log,
           "JSON event log (cycles, reports, telegrams, faults, limit changes, violations)\n"
           "followed by the summary");
@@ -90,9 +99,10 @@ void PrintResult(const Json& s, double wall_s) {
               p["trains_left_line"].get<std::size_t>(), p["train_km"].get<double>());
   if (!s["gap"].is_null()) {
     const auto& g = s["gap"];
-    std::printf("  settled gap (leader %d rear to follower %d front): %.1f m (min %.1f, max %.1f) at %.1f km/h\n",
-                g["leader"].get<int>(), g["follower"].get<int>(), g["settled_gap_m"].get<double>(),
-                g["min_m"].get<double>(), g["max_m"].get<double>(), g["leader_speed_kmh"].get<double>());
+    std::printf(
+        "  settled gap (leader %d rear to follower %d front): %.1f m (min %.1f, max %.1f, sd %.1f) at %.1f km/h\n",
+        g["leader"].get<int>(), g["follower"].get<int>(), g["settled_gap_m"].get<double>(), g["min_m"].get<double>(),
+        g["max_m"].get<double>(), g["std_m"].get<double>(), g["leader_speed_kmh"].get<double>());
   }
   for (const auto& v : s["violation_list"]) {
     std::printf("  VIOLATION t=%.1f s %s: %s\n", v["t_s"].get<double>(), v["requirement"].get<std::string>().c_str(),
@@ -100,10 +110,31 @@ void PrintResult(const Json& s, double wall_s) {
   }
 }
 
+// Every train type of the directory (its *.json files, by name).
+std::vector<railproof::offline::TrainType> LoadTrainTypes(const std::string& dir) {
+  std::vector<std::filesystem::path> files;
+  std::error_code ec;
+  for (const auto& e : std::filesystem::directory_iterator(dir, ec)) {
+    if (e.is_regular_file() && e.path().extension() == ".json") {
+      files.push_back(e.path());
+    }
+  }
+  if (ec) {
+    throw InputError(dir + ": cannot read the train-type directory: " + ec.message());
+  }
+  std::sort(files.begin(), files.end());
+  std::vector<railproof::offline::TrainType> types;
+  for (const auto& f : files) {
+    types.push_back(railproof::offline::LoadTrainType(f));
+  }
+  return types;
+}
+
 int Main(int argc, char** argv) {
   const Options o = ParseArgs(argc, argv);
   const auto base = railproof::sim::LoadScenario(o.scenario);
   const auto line = railproof::offline::LoadLine(railproof::offline::LinePath(o.lines_dir, base.line));
+  const auto types = LoadTrainTypes(o.trains_dir);
   const railproof::offline::Progress progress("line_sim", o.quiet);
   railproof::offline::OutputFiles out;
   for (const std::string& path : {o.summary, o.svg}) {
@@ -120,7 +151,7 @@ int Main(int argc, char** argv) {
     for (const double cap : o.sweep) {
       auto sc = base;
       SetLeaderCap(sc, cap);
-      railproof::sim::Simulation sim(sc, line);
+      railproof::sim::Simulation sim(sc, line, types);
       const auto t0 = std::chrono::steady_clock::now();
       railproof::sim::RunOptions ro;
       ro.progress = std::cref(progress);
@@ -154,7 +185,7 @@ int Main(int argc, char** argv) {
   if (o.leader_cap_kmh > 0.0) {
     SetLeaderCap(sc, o.leader_cap_kmh);
   }
-  railproof::sim::Simulation sim(sc, line);
+  railproof::sim::Simulation sim(sc, line, types);
   railproof::sim::RunOptions ro;
   ro.progress = std::cref(progress);
   ro.log_full = o.log_full;

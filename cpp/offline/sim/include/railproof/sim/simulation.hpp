@@ -1,40 +1,45 @@
-// Offline line scenario simulation (issue 3 item 6): runs one running line with several
-// trains, the runtime ground (mb::wayside::Ground) and on-board authority handling
-// (mb::onboard::AuthorityReceiver, SpeedRestrictionStore), simple longitudinal dynamics
-// (dynamics.hpp), position reports and stop-limit telegrams carried through the real radio
-// telegram layer (tg::Endpoint, frames with RS + CRC + AEAD) over a lossy, delaying
-// channel (channel.hpp), and injected faults. Safety invariants are checked on the true
-// state after every step; an event log (JSON), a summary (JSON) and a time-distance
-// diagram (SVG) are produced.
+// Offline system simulation of a running line (issue 15 item 4): every train is its true
+// motion (the one train-motion model, dynamics.hpp: traction, running resistance, gradients),
+// its sensors (sensors.hpp: tachogenerator, IMU, balises), the real on-board unit
+// (units::OnboardUnit: odometry, braking supervision, crossing protection, radio) and a driver
+// model; the ground is the real wayside unit (units::WaysideUnit: radio endpoints, moving-block
+// ground, crossing controllers). The units talk only through their telegram frames over a
+// lossy, delaying channel (channel.hpp). The crossings' lights and barriers follow the wayside
+// unit's commands. Faults and commands go through the units' interfaces. Safety invariants are
+// checked on the true state after every step; an event log (JSON), a summary (JSON) and a
+// time-distance diagram (SVG) are produced. Design note: spec/design/sim.md.
 //
-// One step of length step_ms at time t (t = 0, step, 2 step, ...):
+// One step of step_ms (= the on-board cycle, 100 ms) at time t:
 //   1. scheduled commands and fault windows at t (possession request/cancel, siding route
 //      request/free, speed restriction request+confirm/cancel; radio / tracking loss),
-//   2. trains due to enter are registered with the ground (deferred while the entry is
-//      not clear of other trains and their authorities),
-//   3. frames due at t are delivered: POSITION to the ground endpoint of that train (an
-//      accepted one is decoded and given to Ground::OnReport), CONTROL to the train's
-//      endpoint (an accepted one is decoded and given to AuthorityReceiver::Receive),
-//   4. if t is a ground cycle: handovers ahead of trains are secured, Ground::Cycle(t),
-//      and every registered train's ground endpoint sends one CONTROL telegram (its stop
-//      limit, or a keep-alive without limit when the ground gives none),
-//   5. trains whose report time has come send one POSITION telegram (report_period_ms),
-//   6. every train's driver / supervision chooses a control and the dynamics advance to
-//      t + step; odometry (under-reading, reset at balises) and the length correction
-//      (length_correction_ppm of the distance since the last balise) are updated,
-//   7. invariants are checked at t + step.
+//   2. trains due to enter are admitted and registered with the wayside unit (deferred while
+//      the entry is not clear of other trains and their authorities); their on-board unit
+//      starts at the entry balise,
+//   3. frames due at t are delivered: a train's to the wayside unit (Receive), the wayside
+//      unit's to the train's on-board unit (read in its cycle at t),
+//   4. if t is a ground cycle: the wayside unit's cycle with the crossings' barrier detection;
+//      its frames go to the channel, its commands to the crossings' equipment,
+//   5. every train: its on-board unit's cycle (sensors of the last 100 ms, balise read, frames,
+//      driver inputs); its telegram to the channel; the driver and the brake equipment choose
+//      the control (the unit's brake demand overrides the driver); the true motion advances to
+//      t + step and the sensors record it,
+//   6. invariants are checked at t + step.
 //
 // Invariants (violation = recorded with time and details; the CLI exits non-zero):
-//   REQ-MB-008  true occupied ranges [front - length, front) of trains never overlap;
-//   ASM-013     true front <= last accepted on-board stop limit + kLimitToleranceM (the
-//               braking-supervision stand-in must discharge it);
+//   REQ-MB-008  true trains keep at least the preceding-train margin between them;
+//   ASM-013     a true front never passes the limit its unit supervises (the movement
+//               authority or the crossing protection limit, REQ-BR-001, REQ-LC-003);
 //   REQ-MB-007  a usable on-board limit never lies beyond the true rear of a train ahead
 //               minus the preceding-train margin;
 //   REQ-MB-009  a usable on-board limit never exceeds the ground's protected authority;
 //   REQ-MB-014  no train inside an active possession;
 //   REQ-MB-011  points never move while a train's true range overlaps their block;
 //   REQ-MB-013  a train is on a set of points only while they lie in the position of the
-//               running line's (automatic) route.
+//               running line's (automatic) route;
+//   REQ-LC-003  a true train occupies a level crossing only while its barriers are down;
+//   REQ-LC-002  ... and only after its lights have warned for the design warning time;
+//   REQ-BR-004  no true speed above the ceiling of the unit's permitted-speed profile under the
+//               train plus the emergency overspeed allowance (REQ-BR-001).
 #pragma once
 
 #include <cstdint>
@@ -49,6 +54,7 @@
 #include <nlohmann/json.hpp>
 
 #include "railproof/offline/line.hpp"
+#include "railproof/offline/train_type.hpp"
 #include "railproof/sim/scenario.hpp"
 
 namespace railproof::sim {
@@ -56,8 +62,8 @@ namespace railproof::sim {
 // the shared offline pieces (line and train data, JSON, plots, command line)
 using namespace ::railproof::offline;  // NOLINT(google-build-using-namespace)
 
-// Discretisation allowance of the ASM-013 check (m): the supervision acts once per step.
-inline constexpr double kLimitToleranceM = 0.5;
+// Allowance of the ASM-013 check (m): none, the patterns include the cycle and reaction times.
+inline constexpr double kLimitToleranceM = 0.0;
 
 struct Violation {
   std::int64_t t_ms = 0;
@@ -72,6 +78,9 @@ struct TrainView {
   double rear_m = 0.0;
   double speed_mps = 0.0;
   std::optional<double> limit_m;  // last accepted on-board limit
+  std::optional<double> supervised_limit_m;  // the limit the unit supervises (authority or crossing)
+  double permitted_speed_mps = 0.0;          // the unit's indication
+  std::string brake;                         // the unit's demand: NONE, SERVICE, EMERGENCY
   bool authority_usable = false;
   bool link_up = false;
   bool emergency = false;
@@ -89,6 +98,7 @@ struct GapResult {
   double mean_m = 0.0;
   double min_m = 0.0;
   double max_m = 0.0;
+  double std_m = 0.0;  // standard deviation over the window
   double leader_speed_kmh = 0.0;    // mean over the window
   double follower_speed_kmh = 0.0;  // mean over the window
 };
@@ -102,8 +112,9 @@ struct RunOptions {
 
 class Simulation {
  public:
-  // Checks the scenario against the line, builds the ground (InputError on bad input).
-  Simulation(Scenario scenario, Line line);
+  // Checks the scenario against the line, picks each train's type (the one of `types` of the
+  // train's length: its on-board data), builds the units (InputError on bad input).
+  Simulation(Scenario scenario, Line line, std::vector<TrainType> types);
   ~Simulation();
   Simulation(const Simulation&) = delete;
   Simulation& operator=(const Simulation&) = delete;
