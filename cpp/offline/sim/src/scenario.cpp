@@ -80,6 +80,9 @@ TrainSpec ReadTrain(const JsonNode& n, const std::string& entry) {
     idn.Fail("train id must be in 0..65535 and differ from the ground id " + std::to_string(params::tg::ground_id));
   }
   t.id = static_cast<std::uint16_t>(id);
+  if (auto tt = n.OptKey("train_type")) {
+    t.train_type = tt->String();
+  }
   t.performance.length_m = Positive(n.Key("length_m"), 2000.0);
   t.performance.max_speed_mps = n.Key("max_speed_kmh").NumberIn(kSpeed, "km/h") / 3.6;
   t.performance.accel_mps2 = Positive(n.Key("accel_mps2"), 5.0);

@@ -31,6 +31,38 @@ bool KeyOf(const void* context, std::uint32_t train_id, std::array<std::uint8_t,
 
 }  // namespace
 
+const TrainType* Simulation::Impl::TrainTypeOf(const TrainSpec& spec) const {
+  const std::int64_t length_mm = ToMm(spec.performance.length_m);
+  const std::string where = sc.file + ": " + spec.entry;
+  if (spec.train_type) {
+    for (const auto& type : types) {
+      if (type.name == *spec.train_type) {
+        if (type.length_mm != length_mm) {
+          throw InputError(where + ".length_m: " + Fmt(spec.performance.length_m) + " m is not the length of train type " +
+                           type.name + " (" + Fmt(ToM(type.length_mm)) + " m)");
+        }
+        return &type;
+      }
+    }
+    throw InputError(where + ".train_type: no train type " + *spec.train_type + " in the train data");
+  }
+  const TrainType* found = nullptr;
+  for (const auto& type : types) {
+    if (type.length_mm == length_mm) {
+      if (found != nullptr) {
+        throw InputError(where + ": train types " + found->name + " and " + type.name + " both have length " +
+                         Fmt(spec.performance.length_m) + " m: name one with train_type");
+      }
+      found = &type;
+    }
+  }
+  if (found == nullptr) {
+    throw InputError(where + ": no train type of length " + Fmt(spec.performance.length_m) +
+                     " m (the on-board unit's train data); name one with train_type");
+  }
+  return found;
+}
+
 void Simulation::Impl::Setup() {
   rl = &SelectRunningLine(sc, line);
   CheckScenarioAgainstLine(sc, *rl);
@@ -55,15 +87,7 @@ void Simulation::Impl::Setup() {
     auto t = std::make_unique<TrainRt>();
     t->spec = spec;
     t->length_mm = ToMm(spec.performance.length_m);
-    for (const auto& type : types) {
-      if (type.length_mm == t->length_mm) {
-        t->type = &type;
-      }
-    }
-    if (t->type == nullptr) {
-      throw InputError(sc.file + ": " + spec.entry + ": no train type of length " + Fmt(spec.performance.length_m) +
-                       " m (the on-board unit's train data)");
-    }
+    t->type = TrainTypeOf(spec);
     t->limits = PermittedProfile(*rl, t->type->MaxSpeedMmS());
     // The vehicle must be the one the unit's data describe: no more traction than the patterns'
     // run-up assumes, brakes no weaker than the pattern decelerations (REQ-BR-010). A train

@@ -270,6 +270,9 @@ struct Simulation::Impl {
 
   // ---- setup, the step, the event log and violation records (simulation.cpp)
   void Setup();
+  // The train type a scenario train's on-board unit carries: the one it names (train_type),
+  // else the one of its length; an input error if there is none, several, or the lengths differ.
+  [[nodiscard]] const TrainType* TrainTypeOf(const TrainSpec& spec) const;
   void SetupOnboardLine();
   void SetupWayside();
   [[nodiscard]] const mb::wayside::Ground& Ground() const { return wayside->Ground(); }

@@ -14,6 +14,7 @@
 #include <nlohmann/json.hpp>
 
 #include "railproof/offline/line.hpp"
+#include "railproof/testing/input_error.hpp"
 #include "railproof/sim/scenario.hpp"
 #include "railproof/sim/simulation.hpp"
 
@@ -285,6 +286,30 @@ TEST(SimRun, TheSameTrainWithItsRealBrakesStopsInTime) {
   const auto s = RunWithoutViolations(sim);
   EXPECT_TRUE(s["train_data_findings"].empty());
   EXPECT_GT(sim.Train(2)->front_m, 9800.0);  // ran to the end of the line
+}
+
+// The train type the on-board unit carries: named by train_type, else found by length; a
+// name the train data lack, a length that is not the named type's, or two types of one length
+// without a name are input errors naming the entry.
+TEST(SimRun, TheTrainTypeIsNamedOrFoundByLength) {
+  nlohmann::json j = ScenarioJson(10);
+  j["trains"].push_back(TrainJson(2, 1000, 0));
+  EXPECT_NO_THROW((void)Make(j));
+  j["trains"][0]["train_type"] = "test100";
+  EXPECT_NO_THROW((void)Make(j));
+  j["trains"][0]["train_type"] = "nonesuch";
+  testing::ExpectInputError([&] { (void)Make(j); }, "unit.json", {"unit.json: trains[0].train_type: no train type nonesuch"});
+  j["trains"][0]["train_type"] = "test100";
+  j["trains"][0]["length_m"] = 90;
+  testing::ExpectInputError([&] { (void)Make(j); }, "unit.json",
+                            {"unit.json: trains[0].length_m: 90.00 m is not the length of train type test100"});
+  j["trains"][0].erase("train_type");
+  j["trains"][0]["length_m"] = 100;
+  TrainType twin = TestType();
+  twin.name = "twin100";
+  testing::ExpectInputError(
+      [&] { (void)Simulation(ParseScenario(j.dump(), "unit.json"), TestLine(), {TestType(), twin}); }, "unit.json",
+      {"unit.json: trains[0]: train types test100 and twin100 both have length 100.00 m: name one with train_type"});
 }
 
 TEST(SimRun, TrainsStopAtStationsAndLeaveAtTheTerminus) {

@@ -33,6 +33,7 @@ struct TrainSpec {
   std::int64_t depart_ms = 0;  // leaves its initial position at this time (>= enter_ms)
   std::vector<StopSpec> stops;
   std::optional<double> speed_cap_mps;  // e.g. a leader limited to 20 km/h
+  std::optional<std::string> train_type;  // the spec/trains type the on-board unit carries
   std::string entry;                    // path in the file, for messages ("trains[1]")
 };
 
