@@ -17,9 +17,11 @@
 // limits act on the whole train: RunningLine::ForEachLimitActing (line.hpp).
 //
 // Every offline train motion is this model, each integrated the way its purpose needs:
-//   line simulator (sim)      fixed time steps (Advance of NetAcceleration) with the driver and
-//                             the supervision stand-in in the loop; mean gradient under the
-//                             train, running resistance; SI units, gravity kGravity;
+//   system simulator (sim)    fixed 100 ms steps (Advance of NetAcceleration) with the driver
+//                             and the real on-board unit in the loop (its brake demand acts on
+//                             the applied acceleration); mean gradient under the train,
+//                             running resistance; SI units, gravity kGravity; the sensor model
+//                             derives the odometry's TG and IMU streams from the same motion;
 //   margin verification (br)  the worst case integrated exactly over the pieces of the most
 //                             falling gradient under the train: run-up under traction
 //                             (Advance, SpeedAfter, TimeOver), then braking to a stop
@@ -42,16 +44,6 @@
 // Not this model: the Box2D wheel-rail simulator (ra) is multi-body creep physics (car body,
 // bogies, wheelsets, slip-dependent adhesion per wheelset): slip and slide, its subject, do
 // not exist for a point mass.
-//
-// Braking supervision stand-in of the line simulation (ASM-013 is what it discharges): the
-// on-board unit supervises its stop limit L with its safe front x (estimated front + length
-// correction) and d = L - x:
-//   service curve  v_s(d) = CurveSpeed(d - margin, beta_s', free_running_s),
-//   emergency curve v_e(d) = CurveSpeed(d, beta_e', emergency_free_running_s),
-//   beta' = nominal deceleration minus GradeDecel(steepest falling gradient up to L).
-// The driving controller never aims above v_s (service brake follows it); if v > v_e the
-// emergency brake is applied and held until standstill. An unusable authority (no limit,
-// expired, or radio link down) means standstill: emergency brake.
 //
 // Offline module.
 #pragma once
