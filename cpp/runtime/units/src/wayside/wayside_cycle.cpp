@@ -201,7 +201,7 @@ void WaysideUnit::CentreStep(std::int64_t now_ms) noexcept {
 // replaces the one still waiting (only the latest state matters), an acknowledgement waiting
 // already is not repeated; so at most one of each per crossing waits.
 void WaysideUnit::Enqueue(Slot& s, const messages::Message& m) noexcept {
-  messages::Message* box = &outbox_[SlotIndex(s) * outbox_per_slot_];
+  messages::Message* box = outbox_.begin() + SlotIndex(s) * outbox_per_slot_;  // none without crossings (null + 0)
   const auto* report = std::get_if<messages::CrossingReport>(&m);
   const auto* ack = std::get_if<messages::WithdrawalAck>(&m);
   for (std::size_t i = 0; i < s.outbox_count; ++i) {
@@ -387,7 +387,7 @@ void WaysideUnit::SendStep(std::int64_t now_ms) noexcept {
       status.kind = messages::Obstruction::kNone;
     }
     // then the crossing messages waiting, in order, as many as fit
-    messages::Message* box = &outbox_[SlotIndex(s) * outbox_per_slot_];
+    messages::Message* box = outbox_.begin() + SlotIndex(s) * outbox_per_slot_;  // none without crossings (null + 0)
     std::size_t taken = 0;
     while (taken < s.outbox_count && bundle.size < messages::kBundleMax) {
       (void)bundle.Add(box[taken]);

@@ -209,8 +209,8 @@ TEST(OnboardUnit, ReportsEveryRejectedInputWithItsReason) {
   rig.Start(4'000'000);
   rig.StepToSend();
   std::vector<std::uint8_t> corrupt = rig.Ground().Send(rig.Now(), std::vector<messages::Message>{messages::KeepAlive{}});
-  corrupt[70] ^= 0xFF;  // a whole RS block beyond correction: 9 symbols
-  for (std::size_t i = 0; i < 9; ++i) {
+  ASSERT_GE(corrupt.size(), 66U);
+  for (std::size_t i = 0; i < 9; ++i) {  // 9 symbols of the first RS block: beyond correction
     corrupt[i * 7] ^= 0xA5;
   }
   rig.Deliver(corrupt);
