@@ -511,6 +511,18 @@ std::size_t BundleSize(std::span<const Message> messages) noexcept {
   return messages.empty() ? 0 : total;
 }
 
+bool AddIfFits(Bundle& bundle, const Message& m) noexcept {
+  if (!bundle.Add(m)) {
+    return false;
+  }
+  const std::size_t size = BundleSize(bundle.View());
+  if (size == 0 || size > kPayloadCapacity) {
+    --bundle.size;
+    return false;
+  }
+  return true;
+}
+
 DecodedBundle DecodeBundle(std::span<const std::uint8_t> payload) noexcept {
   if (payload.empty() || payload[0] != kBundleType) {
     const Decoded one = Decode(payload);

@@ -672,6 +672,27 @@ TEST(MessagesCodec, BundleEncodeRefusals) {
   EXPECT_EQ(BundleSize(with_bad), 0U);
 }
 
+// A sender fills a bundle in priority order: what does not fit is refused and changes nothing.
+TEST(MessagesCodec, AddIfFitsKeepsTheBundleWithinOnePayload) {
+  Bundle b;
+  ASSERT_TRUE(AddIfFits(b, Message{test::StopLimitMax()}));  // 120 bytes alone
+  EXPECT_FALSE(AddIfFits(b, Message{test::PositionMax()}));  // 2 + 121 + 51 > 128
+  EXPECT_EQ(b.size, 1U);
+  EXPECT_TRUE(EncodeBundle(b.View()).Ok());
+  Bundle small;
+  std::size_t n = 0;
+  while (AddIfFits(small, Message{CrossingRequest{7, static_cast<std::uint32_t>(n)}})) {
+    ++n;
+  }
+  EXPECT_EQ(n, kBundleMax) << "eight 9-byte requests fit 2 + 8 x 10 bytes";
+  EXPECT_TRUE(EncodeBundle(small.View()).Ok());
+  PositionReport bad = test::PositionMax();
+  bad.length_mm = 0;
+  Bundle refused;
+  EXPECT_FALSE(AddIfFits(refused, Message{bad})) << "a message the codec refuses is not added";
+  EXPECT_EQ(refused.size, 0U);
+}
+
 TEST(MessagesCodec, BundleDecodeRejections) {
   const Bytes good = ToBytes(EncodeBundle(UplinkBundle()).payload);
   const auto decode = [](const Bytes& b) { return DecodeBundle(b); };

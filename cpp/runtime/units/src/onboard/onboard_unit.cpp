@@ -253,11 +253,7 @@ void OnboardUnit::Send(const ra::OdometryOutput& o) noexcept {
     const std::size_t i = (pending_cursor_ + k) % pending;
     const messages::CrossingRequest r{train_id_, i < p.request_count ? p.requests[i] : p.withdrawals[i - p.request_count]};
     const messages::Message m = i < p.request_count ? messages::Message{r} : messages::Message{messages::CrossingWithdrawal{r}};
-    if (!bundle.Add(m)) {
-      break;
-    }
-    if (messages::BundleSize(bundle.View()) > messages::kPayloadCapacity) {
-      --bundle.size;
+    if (!messages::AddIfFits(bundle, m)) {
       break;
     }
     ++added;

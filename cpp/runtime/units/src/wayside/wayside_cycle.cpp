@@ -389,12 +389,7 @@ void WaysideUnit::SendStep(std::int64_t now_ms) noexcept {
     // then the crossing messages waiting, in order, as many as fit
     messages::Message* box = outbox_.begin() + SlotIndex(s) * outbox_per_slot_;  // none without crossings (null + 0)
     std::size_t taken = 0;
-    while (taken < s.outbox_count && bundle.size < messages::kBundleMax) {
-      (void)bundle.Add(box[taken]);
-      if (messages::BundleSize(bundle.View()) > messages::kPayloadCapacity) {
-        --bundle.size;
-        break;
-      }
+    while (taken < s.outbox_count && messages::AddIfFits(bundle, box[taken])) {
       ++taken;
     }
     for (std::size_t i = taken; i < s.outbox_count; ++i) {

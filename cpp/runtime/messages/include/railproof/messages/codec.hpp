@@ -250,6 +250,11 @@ struct DecodedBundle {
 // exceed kPayloadCapacity (then EncodeBundle refuses).
 [[nodiscard]] std::size_t BundleSize(std::span<const Message> messages) noexcept;
 
+// Appends m to the bundle if the bundle then still fits one payload (kBundleMax messages,
+// kPayloadCapacity bytes); false and no change otherwise (or when m is refused). Senders fill
+// a bundle in priority order with it and keep what does not fit for their next telegram.
+[[nodiscard]] bool AddIfFits(Bundle& bundle, const Message& m) noexcept;
+
 // The messages of a payload: a plain payload (types 1..9) is a bundle of one; a BUNDLE is read
 // entry by entry, each with Decode. Whole or nothing: any error leaves the bundle empty.
 // Errors: those of Decode (the entry's, with `entry`), kWrongLength for a bundle whose entries do
