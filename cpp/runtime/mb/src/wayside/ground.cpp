@@ -256,10 +256,10 @@ ConfigError Ground::Init(const LineConfig& line, const Capacity& cap, std::size_
   const std::size_t n_fixed = line.fixed_blocks.size();
   const std::size_t trains = cap.trains;
 
-  bool ok = CopyInto(blocks_, blocks, blocks.size()) && CopyInto(fixed_blocks_, line.fixed_blocks, n_fixed) &&
-            CopyInto(setback_, line.setback_sections, line.setback_sections.size()) &&
-            CopyInto(no_stop_, line.no_stop_sections, line.no_stop_sections.size()) &&
-            CopyInto(points_, line.points, n_points) && CopyInto(handovers_, line.handovers, n_handovers) &&
+  bool ok = blocks_.AssignFrom(blocks, blocks.size()) && fixed_blocks_.AssignFrom(line.fixed_blocks, n_fixed) &&
+            setback_.AssignFrom(line.setback_sections, line.setback_sections.size()) &&
+            no_stop_.AssignFrom(line.no_stop_sections, line.no_stop_sections.size()) &&
+            points_.AssignFrom(line.points, n_points) && handovers_.AssignFrom(line.handovers, n_handovers) &&
             routes_.Allocate(n_routes) && handover_ids_.Allocate(n_handovers) &&
             AllocateFull(points_reverse_, n_points);
   if (!ok) {
@@ -333,16 +333,7 @@ bool Ground::SectionOnLine(const Section& s) const noexcept {
 }
 
 std::optional<BlockPosition> Ground::LocateFront(std::int64_t front_mm) const noexcept {
-  if (front_mm < 0 || front_mm > length_mm_) {
-    return std::nullopt;
-  }
-  if (front_mm == 0) {
-    return BlockPosition{0, 0};
-  }
-  // the block holding the foremost millimetre front_mm - 1
-  const auto it = std::upper_bound(blocks_.begin(), blocks_.end(), front_mm - 1);
-  const auto block = static_cast<std::size_t>(it - blocks_.begin()) - 1;
-  return BlockPosition{static_cast<std::uint32_t>(block), front_mm - blocks_[block]};
+  return core::LocateFront(blocks_.Span(), front_mm);  // the blocks end at the line's end (Init)
 }
 
 // ---- the cycle ----------------------------------------------------------------------------

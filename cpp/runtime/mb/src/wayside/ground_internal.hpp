@@ -55,18 +55,6 @@ bool UniqueIds(std::span<const T> list, std::size_t& entry) noexcept {
   return true;
 }
 
-template <typename T>
-bool CopyInto(FixedVector<T>& dst, std::span<const T> src, std::size_t capacity) noexcept {
-  if (!dst.Allocate(capacity)) {
-    return false;  // GCOVR_EXCL_LINE defensive: out of memory
-  }
-  for (const T& x : src) {
-    if (!dst.PushBack(x)) {
-      return false;  // GCOVR_EXCL_LINE unreachable: capacity >= src.size() checked
-    }
-  }
-  return true;
-}
 
 // A command adding an entry to a list of the ground (possessions, speed restrictions,
 // unequipped occupancies): kInvalidRange if its arguments are not `valid`, kCapacityExceeded

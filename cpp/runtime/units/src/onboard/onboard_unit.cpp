@@ -19,13 +19,7 @@ bool MultipleOfCycle(std::int64_t ms) noexcept { return ms > 0 && ms % kOnboardC
 // Copies `from` into `to`, allocated to its size (at least 1 so that a span is never dangling).
 template <typename T>
 bool CopyInto(std::span<const T> from, core::FixedVector<T>& to) noexcept {
-  if (!to.Allocate(std::max<std::size_t>(from.size(), 1))) {
-    return false;  // GCOVR_EXCL_LINE defensive: out of memory at initialisation
-  }
-  for (const T& x : from) {
-    (void)to.PushBack(x);
-  }
-  return true;
+  return to.AssignFrom(from, std::max<std::size_t>(from.size(), 1));
 }
 
 ConfigCheck Fail(OnboardConfigError e, std::size_t entry = 0) noexcept {
@@ -222,17 +216,13 @@ messages::Message OnboardUnit::Report(const ra::OdometryOutput& o) const noexcep
   const std::int64_t correction = ra::ReportCorrectionMm(o);
   // The envelope's rear end of the front would report the train behind where it may be.
   const std::int64_t front = RAILPROOF_FAULT(FAULT_UNIT_REPORT_UNSAFE_END) ? o.front_mm - correction : o.front_mm;
-  if (!o.position_valid || front < 0 || front > blocks_[blocks_.Size() - 1]) {
+  const auto at = core::LocateFront(blocks_.Span(), front);
+  if (!o.position_valid || !at) {
     return messages::NoPosition{};
   }
-  std::size_t block = 0;
-  if (front > 0) {
-    const auto it = std::upper_bound(blocks_.begin(), blocks_.end(), front - 1);
-    block = static_cast<std::size_t>(it - blocks_.begin()) - 1;
-  }
   return messages::PositionReport{train_id_,
-                                  static_cast<std::uint32_t>(block),
-                                  front - blocks_[block],
+                                  at->block,
+                                  at->offset_mm,
                                   length_mm_,
                                   correction,
                                   o.last_balise_mm,

@@ -32,7 +32,8 @@ const CycleOutput& WaysideUnit::Cycle(std::int64_t now_ms, const CycleInput& inp
   out_.released.Clear();
   out_.events.Clear();
   if (now_ms < last_cycle_ms_) {
-    out_.status = CycleStatus::kClockWentBack;  // nothing done, nothing sent (safe side)
+    // nothing done, nothing sent (safe side); the crossing equipment keeps its last commands
+    out_.status = CycleStatus::kClockWentBack;
     return out_;
   }
   out_.status = CycleStatus::kDone;
@@ -155,8 +156,7 @@ void WaysideUnit::BoundaryAcceptance() noexcept {
 // The centre schedulers of the GNSS-time variant (lc design §5): the acknowledgements and
 // reports of the controllers' last cycle, the train's centre position report; their start
 // times and stops go to the controllers in this cycle.
-// @implements REQ-LC-008
-// @implements REQ-LC-010
+// Connects the centre schedulers (REQ-LC-008, REQ-LC-010, implemented in lc) to the controllers.
 void WaysideUnit::CentreStep(std::int64_t now_ms) noexcept {
   for (CrossingSlot& c : crossings_) {
     c.start_time_count = 0;
@@ -220,9 +220,8 @@ void WaysideUnit::Enqueue(Slot& s, const messages::Message& m) noexcept {
   }
 }
 
-// @implements REQ-LC-003
-// @implements REQ-LC-006
-// @implements REQ-LC-007
+// Connects the crossing controllers (REQ-LC-003, REQ-LC-006, REQ-LC-007, implemented in lc) to
+// the trains' telegrams and the crossing equipment.
 void WaysideUnit::CrossingStep(std::int64_t now_ms, std::span<const CrossingSensors> sensors) noexcept {
   for (const CrossingSensors& x : sensors) {
     if (FindCrossing(x.crossing_id) == nullptr) {
@@ -345,8 +344,8 @@ void WaysideUnit::CapAtBoundary(const Slot& s, messages::StopLimitTelegram& t) c
   }
 }
 
+// One telegram per train and cycle through its endpoint (REQ-TG-008, implemented in tg).
 // @implements REQ-MB-024
-// @implements REQ-TG-008
 void WaysideUnit::SendStep(std::int64_t now_ms) noexcept {
   for (Slot& s : slots_) {
     if (!s.used) {

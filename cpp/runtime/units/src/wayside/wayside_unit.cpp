@@ -74,10 +74,11 @@ ConfigError WaysideUnit::Init(const WaysideConfig& config, CreateResult& result)
   const std::size_t events = 2 * trains + config.crossings.size() + 2 * kMaxNeighbourMessages + config.departures;
   if (!slots_.Allocate(trains) || !slots_.Resize(trains) || !handover_mm_.Allocate(cells) ||
       !handover_ids_.Allocate(cells) || !cell_load_.Allocate(cells) || !cell_load_.Resize(cells) ||
-      !blocks_mm_.Allocate(config.line.blocks_mm.size()) || !outbox_.Allocate(trains * outbox_per_slot_) ||
+      !blocks_mm_.AssignFrom(config.line.blocks_mm, config.line.blocks_mm.size()) ||
+      !outbox_.Allocate(trains * outbox_per_slot_) ||
       !outbox_.Resize(trains * outbox_per_slot_) || !crossings_.Allocate(config.crossings.size()) ||
       !departures_.Allocate(config.departures) || !departures_.Resize(config.departures) ||
-      !departure_crossings_.Allocate(config.crossings.size()) || !profile_.Allocate(config.profile.size()) ||
+      !departure_crossings_.Allocate(config.crossings.size()) || !profile_.AssignFrom(config.profile, config.profile.size()) ||
       !last_reports_.Allocate(config.crossings.size()) || !out_.frames.Allocate(trains) ||
       !out_.trains.Allocate(trains) || !out_.crossings.Allocate(config.crossings.size()) ||
       !out_.departures.Allocate(config.departures) || !out_.handover_requests.Allocate(trains) ||
@@ -88,12 +89,6 @@ ConfigError WaysideUnit::Init(const WaysideConfig& config, CreateResult& result)
   for (const mb::wayside::HandoverConfig& h : config.line.handovers) {
     (void)handover_mm_.PushBack(h.position_mm);
     (void)handover_ids_.PushBack(h.id);
-  }
-  for (const std::int64_t b : config.line.blocks_mm) {
-    (void)blocks_mm_.PushBack(b);
-  }
-  for (const core::RestrictionSegment& r : config.profile) {
-    (void)profile_.PushBack(r);
   }
   for (std::size_t i = 0; i < config.crossings.size(); ++i) {
     const lc::CrossingData& data = config.crossings[i];
@@ -319,9 +314,8 @@ struct NamedTrain {
 
 }  // namespace
 
-// @implements REQ-LC-002
-// @implements REQ-LC-004
-// @implements REQ-MB-001
+// Routes one received message to the module that owns it (reports: REQ-MB-001 in mb; crossing
+// requests and withdrawals: REQ-LC-002, REQ-LC-004, sent by the on-board unit, taken by lc).
 MessageResult WaysideUnit::Dispatch(Slot& s, const messages::Message& m) noexcept {
   MessageResult r;
   r.type = messages::TypeOf(m);

@@ -42,6 +42,19 @@ class FixedVector {
     return true;
   }
 
+  // Allocates storage for `capacity` elements (only during initialisation) and copies `src`
+  // into it. False if the allocation failed or `src` does not fit.
+  [[nodiscard]] bool AssignFrom(std::span<const T> src, std::size_t capacity) noexcept {
+    if (src.size() > capacity || !Allocate(capacity)) {
+      return false;
+    }
+    for (std::size_t i = 0; i < src.size(); ++i) {
+      data_[i] = src[i];
+    }
+    size_ = src.size();
+    return true;
+  }
+
   // Appends `value`; false (and no change) if the vector is full.
   [[nodiscard]] bool PushBack(const T& value) noexcept {
     if (size_ >= capacity_) {

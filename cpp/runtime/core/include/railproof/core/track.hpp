@@ -4,7 +4,10 @@
 // increasing in the running direction; a section is [begin_mm, end_mm).
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
+#include <optional>
+#include <span>
 
 namespace railproof::core {
 
@@ -45,5 +48,27 @@ struct PositionEstimate {
   std::int64_t speed_mm_s = 0;
   bool standstill = false;  // measured speed zero for the standstill time
 };
+
+// A front as the position report carries it: the virtual block holding its foremost
+// millimetre (front - 1; block 0 for front 0) and the front's offset from that block's start.
+struct BlockPosition {
+  std::uint32_t block;
+  std::int64_t offset_mm;
+};
+
+// The block position of `front_mm` on the virtual-block boundaries `blocks_mm` ([0] = 0,
+// strictly increasing, back() = the line's end); none for a front off the line.
+[[nodiscard]] inline std::optional<BlockPosition> LocateFront(std::span<const std::int64_t> blocks_mm,
+                                                              std::int64_t front_mm) noexcept {
+  if (blocks_mm.empty() || front_mm < 0 || front_mm > blocks_mm.back()) {
+    return std::nullopt;
+  }
+  if (front_mm == 0) {
+    return BlockPosition{0, 0};
+  }
+  const auto it = std::upper_bound(blocks_mm.begin(), blocks_mm.end(), front_mm - 1);
+  const auto block = static_cast<std::size_t>(it - blocks_mm.begin()) - 1;
+  return BlockPosition{static_cast<std::uint32_t>(block), front_mm - blocks_mm[block]};
+}
 
 }  // namespace railproof::core

@@ -317,7 +317,6 @@ struct CycleOutput {
 // @implements REQ-MB-021
 // @implements REQ-MB-023
 // @implements REQ-MB-024
-// @implements REQ-TG-015
 class WaysideUnit {
  public:
   struct CreateResult {
@@ -462,12 +461,12 @@ class WaysideUnit {
   core::FixedVector<std::int64_t> handover_mm_;   // the line's handover points (cell ends)
   core::FixedVector<std::uint32_t> handover_ids_;
   core::FixedVector<std::uint32_t> cell_load_;    // trains holding a channel per base station
-  core::FixedVector<std::int64_t> blocks_mm_;     // virtual block boundaries of the line
   std::size_t outbox_per_slot_ = 0;
   core::FixedVector<messages::Message> outbox_;
   core::FixedVector<CrossingSlot> crossings_;
   core::FixedVector<DepartureSlot> departures_;
   core::FixedVector<lc::CrossingData> departure_crossings_;  // StartDeparture scratch
+  core::FixedVector<std::int64_t> blocks_mm_;     // virtual block boundaries of the line (reports to fronts)
   core::FixedVector<core::RestrictionSegment> profile_;
   core::FixedVector<messages::CrossingReport> last_reports_;  // the controllers' last reports
   std::array<lc::wayside::StartTimeAck, lc::wayside::kMaxSchedulerMessages> start_acks_{};

@@ -258,10 +258,7 @@ constexpr const char* ToString(ReportStatus s) noexcept {
 
 // Front as block + offset (canonical: the block holding position front_mm - 1; block 0,
 // offset 0 for front_mm = 0).
-struct BlockPosition {
-  std::uint32_t block;
-  std::int64_t offset_mm;
-};
+using core::BlockPosition;
 
 // ---- commands -------------------------------------------------------------------------
 
