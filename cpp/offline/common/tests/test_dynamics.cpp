@@ -74,6 +74,33 @@ TEST(Dynamics, ResistanceGradientAndLimits) {
   EXPECT_NEAR(NetAcceleration(NoResistance(), Control{1.0, 0.0, true}, 1.0, 0.0), -1.5, 1e-12);
 }
 
+// The handbook form of an EMU consist (ASM-032) for D2's ten cars (motor cars 170 t, trailers
+// 125 t): a0 = 378/295, a1 = 4.549/295, a2 = 0.0982/295, about 4.65 N/kN at 80 km/h.
+TEST(Dynamics, ConsistResistanceByHand) {
+  const Resistance r = ConsistResistance(Consist{10, 170.0, 125.0});
+  EXPECT_NEAR(r.a0, 378.0 / 295.0, 1e-12);
+  EXPECT_NEAR(r.a1, 4.549 / 295.0, 1e-12);
+  EXPECT_NEAR(r.a2, 0.0982 / 295.0, 1e-12);
+  EXPECT_NEAR(ResistanceDecel(r, 80.0 / 3.6), 9.81 * 4.6454 / 1000.0, 1e-4);
+}
+
+// Traction is constant up to the constant-power speed and falls as 1/v above it; without that
+// speed it stays constant.
+TEST(Dynamics, MaxTractionFallsAboveTheConstantPowerSpeed) {
+  TrainPerformance p;
+  p.accel_mps2 = 1.0;
+  EXPECT_DOUBLE_EQ(MaxTraction(p, 30.0), 1.0);
+  p.constant_power_from_mps = 10.0;
+  EXPECT_DOUBLE_EQ(MaxTraction(p, 5.0), 1.0);
+  EXPECT_DOUBLE_EQ(MaxTraction(p, 10.0), 1.0);
+  EXPECT_DOUBLE_EQ(MaxTraction(p, 20.0), 0.5);
+  p.max_speed_mps = 40.0;
+  Control full;
+  full.traction_mps2 = 1.0;
+  EXPECT_NEAR(NetAcceleration(p, full, 20.0, 0.0), 0.5 - ResistanceDecel(p.resistance, 20.0), 1e-12)
+      << "the commanded traction is capped by the constant-power curve";
+}
+
 TEST(Dynamics, CurveSpeedInvertsTheStoppingDistance) {
   for (const double t : {0.0, 0.5, 2.0}) {
     for (const double v : {1.0, 5.56, 16.7, 27.8}) {

@@ -132,6 +132,7 @@ ApproachPoint FindApproachPoint(const ApproachProblem& p, double grid_step_mps) 
   a.time_s = r.objective;
   a.x = ApproachPosition(p, a.v);
   a.status = r.status;
+  a.solved = r.solved;
   a.iterations = r.iterations;
   return a;
 }

@@ -62,7 +62,6 @@ double PlanExecutor::Wanted(const Corridor& c, const State& s, double dt) {
     case Phase::kCoast:
       break;
   }
-  (void)dt;
   return 0.0;
 }
 
@@ -169,26 +168,11 @@ SlowedResult SlowToRunningTime(const Corridor& c, const State& from, double targ
 
 offline::Control ApplySupervision(double follower_demand, const br::Decision& decision, const Train& train) {
   offline::Control out;
-  double brake = 0.0;
-  switch (decision.level) {
-    case br::BrakeLevel::kNone:
-      break;
-    case br::BrakeLevel::k4N:
-      brake = train.beta * 4.0 / 7.0;
-      break;
-    case br::BrakeLevel::k5N:
-      brake = train.beta * 5.0 / 7.0;
-      break;
-    case br::BrakeLevel::k6N:
-      brake = train.beta * 6.0 / 7.0;
-      break;
-    case br::BrakeLevel::k7N:
-      brake = train.beta;
-      break;
-    case br::BrakeLevel::kEmergency:
-      out.emergency = true;
-      return out;
+  if (decision.level == br::BrakeLevel::kEmergency) {
+    out.emergency = true;
+    return out;
   }
+  const double brake = train.beta * br::ServiceNotchSevenths(decision.level) / 7.0;
   if (brake > 0.0) {
     // any supervision brake removes the traction; the follower may brake harder, never less
     out.brake_mps2 = std::max(brake, -follower_demand);

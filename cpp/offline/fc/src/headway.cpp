@@ -182,7 +182,7 @@ nlohmann::ordered_json StudyJson(const StudyResult& r, bool* pass) {
       best_reduction = std::max(best_reduction, d.runs[0].interval_s - d.runs[2].interval_s);
     }
     const double diff_s = c.approach.time_s - c.approach.grid_time_s;
-    const bool cross = c.approach.status != "failed" && std::abs(diff_s) <= tolerance_s;
+    const bool cross = c.approach.solved && std::abs(diff_s) <= tolerance_s;
     const bool meets = cross && excess <= 1e-6 && arrived;
     ok = ok && meets;
     cases.push_back(J{{"case", CaseName(c.which)},

@@ -97,7 +97,6 @@ struct Sample {
 struct OnboardLine {
   std::vector<std::int64_t> blocks_mm;
   std::vector<core::GradientSegment> gradients;
-  std::vector<core::RestrictionSegment> speed_limits;  // per train type (capped at its maximum)
   std::vector<units::BaliseEntry> balises;             // id = index + 1 in the running line
   std::vector<lc::CrossingData> crossings;             // id = index + 1 in the running line
   std::vector<ra::OdometrySection> sections;
@@ -136,7 +135,6 @@ struct TrainRt {
   std::int64_t odometry_stopped_ms = 0;  // standing with the odometry stopped (not at start-up)
   // ground view
   bool abnormal = false;
-  std::optional<std::int64_t> ground_limit;
   messages::Obstruction ground_kind = messages::Obstruction::kNone;
   // statistics
   std::int64_t entered_ms = -1;

@@ -120,7 +120,6 @@ void Simulation::Impl::GroundCycle() {
                 {"limit_mm", s.limit_mm ? Json(*s.limit_mm) : Json(nullptr)}});
     }
     t->abnormal = s.abnormal;
-    t->ground_limit = s.limit_mm;
     t->ground_kind = s.kind;
     if (s.limit_mm) {
       ++telegrams_issued;

@@ -218,22 +218,6 @@ void Simulation::Impl::OnboardCycle(TrainRt& t) {
   }
 }
 
-namespace {
-
-// The service brake notch of a supervision level: 7N the full service brake, the mild brakes
-// 4N..6N the share of their notch (D5 §5.5: 4N-7N follow the pattern; the odometry's TG
-// cannot tell a notch from a slide, so the brake is applied as graded as the unit asks).
-double ServiceShare(br::BrakeLevel level) {
-  switch (level) {
-    case br::BrakeLevel::k4N: return 4.0 / 7.0;
-    case br::BrakeLevel::k5N: return 5.0 / 7.0;
-    case br::BrakeLevel::k6N: return 6.0 / 7.0;
-    default: return 1.0;
-  }
-}
-
-}  // namespace
-
 // The driver and the brake equipment. The unit's demand overrides the driver: SERVICE is the
 // service brake at the unit's notch (7N: full), EMERGENCY the emergency brake held until
 // standstill. Otherwise the driver
@@ -263,7 +247,7 @@ Control Simulation::Impl::Drive(TrainRt& t, const units::OnboardOutputs& o, doub
     c.emergency = true;
   } else if (o.brake == units::BrakeDemand::kService) {
     t.brake = Brake::kService;
-    c.brake_mps2 = p.service_decel_mps2 * ServiceShare(o.level);
+    c.brake_mps2 = p.service_decel_mps2 * br::ServiceNotchSevenths(o.level) / 7.0;  // graded as the unit asks
     if (prev != Brake::kService) {
       ++t.service_brakes;
     }

@@ -208,10 +208,11 @@ TEST(SimRun, TrackingLossMarksTheTrainAbnormalAndHoldsTheFollower) {
   j["faults"] = {{{"type", "tracking_loss"}, {"train", 2}, {"from_s", 90}, {"to_s", 150}}};
   Simulation sim = Make(j);
   const TrainView leader = StandingAt(sim, 149'000, 2);
-  const TrainView follower = sim.Train(3).value_or(TrainView{});
+  const auto follower = sim.Train(3);
+  ASSERT_TRUE(follower.has_value()) << "the follower is on the line";
   EXPECT_TRUE(leader.abnormal);
   // the follower stands at least the abnormal-train margin behind the leader's rear
-  EXPECT_GT(leader.rear_m - follower.front_m, 50.0);
+  EXPECT_GT(leader.rear_m - follower->front_m, 50.0);
   const auto f = RunWithoutViolations(sim)["faults"][0];
   ASSERT_FALSE(f["abnormal_after_s"].is_null());
   EXPECT_LE(f["abnormal_after_s"].get<double>(), 4.5);

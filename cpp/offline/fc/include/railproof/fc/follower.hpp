@@ -152,7 +152,8 @@ double TimeFromApproach(const ApproachProblem& p, double v);
 struct ApproachPoint {
   double x = 0.0, v = 0.0, time_s = 0.0;  // the optimum (Ipopt)
   double grid_v = 0.0, grid_time_s = 0.0;  // the grid's best
-  std::string status;                      // Ipopt's
+  std::string status;                      // Ipopt's, as text
+  bool solved = false;                     // Ipopt solved it (or to the acceptable level)
   int iterations = 0;
 };
 

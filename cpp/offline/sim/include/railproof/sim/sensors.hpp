@@ -7,7 +7,9 @@
 //                   the capture time of the latest edge, solved exactly from the motion;
 //   IMU             ten samples at 10 ms: a_x = train acceleration + g sin(theta), a_z =
 //                   g cos(theta), pitch rate from the change of the gradient under the train,
-//                   plus seeded white noise (ASM-027's noise level);
+//                   plus seeded white noise (0.02 m/s^2, 0.0005 rad/s: below the wheel-rail
+//                   simulator's ASM-027 levels; the system simulation is not an odometry
+//                   study, whose errors cpp/offline/ra exercises);
 //   balise          the fix of a balise the front passed during the cycle (line position).
 // No slip or slide: the wheel rolls with the train (adhesion is the wheel-rail simulator's
 // subject, cpp/offline/ra; the system simulation runs on dry rail, stated in the scenarios).

@@ -20,6 +20,20 @@ constexpr const char* ToString(BrakeLevel l) noexcept {
   return core::EnumName(l, std::array<const char*, 6>{"NONE", "4N", "5N", "6N", "7N", "EB"});
 }
 
+// The service brake a level commands in sevenths of the full service brake (D5 §5.5: the
+// notches 4N..7N): 4..7; 0 for none and for the emergency brake, which is no service notch.
+constexpr int ServiceNotchSevenths(BrakeLevel l) noexcept {
+  switch (l) {
+    case BrakeLevel::k4N: return 4;
+    case BrakeLevel::k5N: return 5;
+    case BrakeLevel::k6N: return 6;
+    case BrakeLevel::k7N: return 7;
+    case BrakeLevel::kNone:
+    case BrakeLevel::kEmergency: return 0;
+  }
+  return 0;
+}
+
 // A pattern speed of kNoPermittedSpeed means that not even standing is permitted at that
 // point (the run-up from rest already reaches the target, or the input was invalid): every
 // supervised speed, 0 included, exceeds it, so a standing train is held by the brake and a
