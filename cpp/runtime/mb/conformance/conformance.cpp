@@ -34,7 +34,7 @@
 #include "railproof/mb/wayside/ground.hpp"
 #include "railproof/testing/jsonl_runner.hpp"
 #include "vector_keys.hpp"
-#include "../tests/line_data.hpp"
+#include "line_from_vector.hpp"
 
 namespace rcli = railproof::conformance;
 
@@ -44,10 +44,11 @@ namespace rw = railproof::mb::wayside;
 namespace ro = railproof::mb::onboard;
 using json = nlohmann::json;
 using railproof::mb::wayside::test::LineData;
-
-constexpr std::uint32_t kMainRouteId = 1;
-constexpr std::uint32_t kSidingRouteId = 2;
-constexpr std::uint32_t kHandoverId = 1;
+using railproof::mb::conformance::BuildLine;
+using railproof::mb::conformance::kHandoverId;
+using railproof::mb::conformance::kMainRouteId;
+using railproof::mb::conformance::kSidingRouteId;
+using railproof::mb::conformance::SectionOf;
 
 struct Header {
   std::int64_t tick_ms = 0;
@@ -73,35 +74,6 @@ std::string ReadHeader(const std::string& file, const json& obj) {
   return "";
 }
 
-rw::Section SectionOf(const json& a) { return rw::Section{a.at(0).get<std::int64_t>(), a.at(1).get<std::int64_t>()}; }
-
-// The model's line as a ground configuration (design note §2 mapping).
-void BuildLine(const Header& h, LineData& d) {
-  const json& p = h.p;
-  d.blocks = p.at("blocks_mm").get<std::vector<std::int64_t>>();
-  d.fixed = {SectionOf(p.at("platform_mm"))};
-  d.setback = d.fixed;  // the platform is the set-back section
-  d.points = {rw::PointsConfig{1, SectionOf(p.at("points_mm"))}};
-  const rw::Section main = SectionOf(p.at("route_main_mm"));
-  const rw::Section pts = SectionOf(p.at("points_mm"));
-  d.routes = {rw::RouteConfig{kMainRouteId, main.begin_mm, main.end_mm, 0, false, true},
-              rw::RouteConfig{kSidingRouteId, pts.begin_mm, pts.end_mm, 0, true, false}};
-  d.handovers = {rw::HandoverConfig{kHandoverId, p.at("handover_mm").get<std::int64_t>()}};
-  const json& m = p.at("margins_mm");
-  d.boundary = p.at("boundary_mm").get<std::int64_t>();
-  rw::LineConfig& l = d.base;
-  l.length_mm = p.at("line_mm").get<std::int64_t>();
-  l.margins = rw::Margins{m.at("train").get<std::int64_t>(),    m.at("fixed_block").get<std::int64_t>(),
-                          m.at("route").get<std::int64_t>(),    m.at("handover").get<std::int64_t>(),
-                          m.at("boundary").get<std::int64_t>(), m.at("possession").get<std::int64_t>(),
-                          m.at("abnormal").get<std::int64_t>(), m.at("eot").get<std::int64_t>()};
-  l.policy = rw::MarginPolicy::kReportedCorrection;
-  l.tracking_timeout_ms = p.at("tracking_timeout_ms").get<std::int64_t>();
-  l.authority_validity_ms = p.at("validity_ms").get<std::int64_t>();
-  l.ground_cycle_ms = h.tick_ms;
-  l.setback_max_mm = l.length_mm;  // the model bounds set-back itself (one unit)
-}
-
 const char* PossessionName(rw::PossessionState s) {
   switch (s) {
     case rw::PossessionState::kNone: return "NONE";
@@ -117,7 +89,7 @@ using rcli::OptInt;
 void Replay(const rcli::JsonVector& v, std::vector<std::string>& problems) {
   const Header& h = g_headers.at(v.file);
   LineData d;
-  BuildLine(h, d);
+  BuildLine(h.p, h.tick_ms, d);
   const auto fronts = h.p.at("initial_front_mm").get<std::vector<std::int64_t>>();
   const auto corrs = h.p.at("initial_correction_mm").get<std::vector<std::int64_t>>();
   rw::Capacity cap = rw::DefaultCapacity();

@@ -24,6 +24,7 @@
 #include <string>
 #include <vector>
 
+#include "mb/conformance/line_from_vector.hpp"
 #include "mb/conformance/vector_keys.hpp"
 #include "railproof/testing/jsonl_runner.hpp"
 #include "wayside_test_support.hpp"
@@ -34,39 +35,11 @@ namespace {
 namespace rc = railproof::conformance;
 using json = nlohmann::json;
 
-constexpr std::uint32_t kMainRouteId = 1;
-constexpr std::uint32_t kSidingRouteId = 2;
-constexpr std::uint32_t kHandoverId = 1;
-
-mb::wayside::Section SectionOf(const json& a) {
-  return mb::wayside::Section{a.at(0).get<std::int64_t>(), a.at(1).get<std::int64_t>()};
-}
-
-// The model's line (spec/design/mb.md §2, as the mb runner builds it).
-void BuildLine(const json& p, std::int64_t tick_ms, mb::wayside::test::LineData& d) {
-  d.blocks = p.at("blocks_mm").get<std::vector<std::int64_t>>();
-  d.fixed = {SectionOf(p.at("platform_mm"))};
-  d.setback = d.fixed;
-  d.points = {mb::wayside::PointsConfig{1, SectionOf(p.at("points_mm"))}};
-  const auto main = SectionOf(p.at("route_main_mm"));
-  const auto pts = SectionOf(p.at("points_mm"));
-  d.routes = {{kMainRouteId, main.begin_mm, main.end_mm, 0, false, true},
-              {kSidingRouteId, pts.begin_mm, pts.end_mm, 0, true, false}};
-  d.handovers = {{kHandoverId, p.at("handover_mm").get<std::int64_t>()}};
-  d.boundary = p.at("boundary_mm").get<std::int64_t>();
-  const json& m = p.at("margins_mm");
-  mb::wayside::LineConfig& l = d.base;
-  l.length_mm = p.at("line_mm").get<std::int64_t>();
-  l.margins = {m.at("train").get<std::int64_t>(),    m.at("fixed_block").get<std::int64_t>(),
-               m.at("route").get<std::int64_t>(),    m.at("handover").get<std::int64_t>(),
-               m.at("boundary").get<std::int64_t>(), m.at("possession").get<std::int64_t>(),
-               m.at("abnormal").get<std::int64_t>(), m.at("eot").get<std::int64_t>()};
-  l.policy = mb::wayside::MarginPolicy::kReportedCorrection;
-  l.tracking_timeout_ms = p.at("tracking_timeout_ms").get<std::int64_t>();
-  l.authority_validity_ms = p.at("validity_ms").get<std::int64_t>();
-  l.ground_cycle_ms = tick_ms;
-  l.setback_max_mm = l.length_mm;
-}
+using mb::conformance::BuildLine;
+using mb::conformance::kHandoverId;
+using mb::conformance::kMainRouteId;
+using mb::conformance::kSidingRouteId;
+using mb::conformance::SectionOf;
 
 struct MbRig {
   mb::wayside::test::LineData line;
