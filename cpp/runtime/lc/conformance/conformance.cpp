@@ -45,6 +45,7 @@
 #include "railproof/lc/wayside/centre_scheduler.hpp"
 #include "railproof/lc/wayside/crossing_controller.hpp"
 #include "railproof/testing/jsonl_runner.hpp"
+#include "vector_config.hpp"
 #include "vector_keys.hpp"
 
 namespace rcli = railproof::conformance;
@@ -56,104 +57,21 @@ namespace ws = railproof::lc::wayside;
 namespace br = railproof::br;
 using json = nlohmann::json;
 
+using railproof::lc::conformance::ConfigFromHeader;
+using railproof::lc::conformance::FileConfig;
+using railproof::lc::conformance::I;
+using railproof::lc::conformance::Ids;
+using railproof::lc::conformance::IsArr;
+using railproof::lc::conformance::IsBool;
+using railproof::lc::conformance::IsInt;
+using railproof::lc::conformance::IsObj;
+using railproof::lc::conformance::ReportOf;
+using railproof::lc::conformance::ReportString;
+
 constexpr const char* kUnits = "model tick = 10000 ms, model cell = 100000 mm (positions in half-cells)";
 constexpr std::int64_t kTickMs = 10000;
 
-// The configuration of one file (its header).
-struct FileConfig {
-  bool gnss = false;
-  std::vector<railproof::lc::CrossingData> crossings;
-  std::vector<railproof::core::RestrictionSegment> restrictions;
-  ob::ProtectionConfig protection;
-  std::vector<ws::ControllerConfig> controllers;
-  ws::SchedulerConfig scheduler;
-  ws::Departure departure;
-  std::int64_t started_at_ms = 0;
-};
-
 std::map<std::string, FileConfig> g_configs;  // per file, from its header
-
-bool IsInt(const json& o, const char* k) { return o.is_object() && o.contains(k) && o[k].is_number_integer(); }
-bool IsBool(const json& o, const char* k) { return o.is_object() && o.contains(k) && o[k].is_boolean(); }
-bool IsArr(const json& o, const char* k) { return o.is_object() && o.contains(k) && o[k].is_array(); }
-bool IsObj(const json& o, const char* k) { return o.is_object() && o.contains(k) && o[k].is_object(); }
-std::int64_t I(const json& o, const char* k) { return o.at(k).get<std::int64_t>(); }
-
-// The configuration of a file's header; "" or the reason it is unusable.
-std::string ConfigFromHeader(const json& h, FileConfig& cfg) {
-  const json& p = h["parameters"];
-  if (!p.is_object() || !IsObj(p, "train") || !IsArr(p, "crossings") || !IsArr(p, "restrictions") ||
-      !IsObj(p, "protection") || !IsObj(p, "controller")) {
-    return "header parameters need train, crossings, restrictions, protection, controller";
-  }
-  const std::string variant = rcli::StringField(h, "variant");
-  if (variant != "ONBOARD" && variant != "GNSS") {
-    return "header variant must be ONBOARD or GNSS";
-  }
-  cfg.gnss = variant == "GNSS";
-  const json& t = p["train"];
-  const json& pr = p["protection"];
-  const json& c = p["controller"];
-  if (!IsInt(t, "id") || !IsInt(t, "length_mm") || !IsInt(t, "accel_max_mm_s2") || !IsInt(pr, "request_lead_ms") ||
-      !IsInt(pr, "confirmation_max_age_ms") || !IsInt(pr, "protection_offset_mm") || !IsInt(pr, "lookahead_mm") ||
-      !IsInt(c, "barrier_lowering_ms") || !IsInt(c, "barrier_timeout_ms") || !IsInt(c, "max_warning_ms") ||
-      !IsInt(c, "holdover_max_ms")) {
-    return "header parameters: a train, protection or controller field is missing or not an integer";
-  }
-  for (const json& x : p["crossings"]) {
-    if (!IsInt(x, "id") || !IsInt(x, "near_mm") || !IsInt(x, "far_mm") || !IsInt(x, "warning_time_ms")) {
-      return "header crossing needs integer id, near_mm, far_mm, warning_time_ms";
-    }
-    cfg.crossings.push_back(railproof::lc::CrossingData{static_cast<std::uint32_t>(I(x, "id")), I(x, "near_mm"), I(x, "far_mm"),
-                                             I(x, "warning_time_ms")});
-  }
-  for (const json& x : p["restrictions"]) {
-    if (!IsInt(x, "begin_mm") || !IsInt(x, "end_mm") || !IsInt(x, "limit_mm_s")) {
-      return "header restriction needs integer begin_mm, end_mm, limit_mm_s";
-    }
-    cfg.restrictions.push_back(railproof::core::RestrictionSegment{I(x, "begin_mm"), I(x, "end_mm"), I(x, "limit_mm_s")});
-  }
-  cfg.protection = ob::DefaultProtectionConfig(static_cast<std::uint32_t>(I(t, "id")), I(t, "length_mm"),
-                                               I(t, "accel_max_mm_s2"));
-  cfg.protection.request_lead_ms = I(pr, "request_lead_ms");
-  cfg.protection.confirmation_max_age_ms = I(pr, "confirmation_max_age_ms");
-  cfg.protection.protection_offset_mm = I(pr, "protection_offset_mm");
-  cfg.protection.lookahead_mm = I(pr, "lookahead_mm");
-  if (const auto r = ob::CrossingProtection::Create(cfg.protection); r.error != ob::ProtectionError::kNone) {
-    return std::string("header protection configuration rejected: ") + ToString(r.error);
-  }
-  for (const railproof::lc::CrossingData& x : cfg.crossings) {
-    ws::ControllerConfig cc = ws::DefaultControllerConfig(x.id);
-    cc.barrier_lowering_ms = I(c, "barrier_lowering_ms");
-    cc.barrier_timeout_ms = I(c, "barrier_timeout_ms");
-    cc.max_warning_ms = I(c, "max_warning_ms");
-    cc.holdover_max_ms = I(c, "holdover_max_ms");
-    if (const auto r = ws::CrossingController::Create(cc); r.error != ws::ControllerError::kNone) {
-      return std::string("header controller configuration rejected: ") + ToString(r.error);
-    }
-    cfg.controllers.push_back(cc);
-  }
-  if (cfg.gnss) {
-    if (!IsObj(p, "scheduler") || !IsInt(p["scheduler"], "clock_allowance_ms") || !IsObj(p, "departure")) {
-      return "GNSS header needs scheduler.clock_allowance_ms and departure";
-    }
-    const json& d = p["departure"];
-    if (!IsInt(d, "train_id") || !IsInt(d, "departure_id") || !IsInt(d, "departure_ms") || !IsInt(d, "front_mm") ||
-        !IsInt(d, "started_at_ms")) {
-      return "header departure needs integer train_id, departure_id, departure_ms, front_mm, started_at_ms";
-    }
-    cfg.scheduler = ws::DefaultSchedulerConfig(I(t, "accel_max_mm_s2"));
-    cfg.scheduler.clock_allowance_ms = I(p["scheduler"], "clock_allowance_ms");
-    if (const auto r = ws::CentreScheduler::Create(cfg.scheduler); r.error != ws::SchedulerError::kNone) {
-      return std::string("header scheduler configuration rejected: ") + ToString(r.error);
-    }
-    cfg.departure = ws::Departure{static_cast<std::uint32_t>(I(d, "train_id")),
-                                  static_cast<std::uint32_t>(I(d, "departure_id")), I(d, "departure_ms"),
-                                  I(d, "front_mm")};
-    cfg.started_at_ms = I(d, "started_at_ms");
-  }
-  return "";
-}
 
 // ---- step shape ------------------------------------------------------------------------------
 bool IdsOk(const json& o, const char* k) {
@@ -284,45 +202,6 @@ std::string Str(std::int64_t x) { return std::to_string(x); }
 using rcli::Bool;
 using rcli::Checker;
 using rcli::OptInt;
-std::string Ids(const json& a) {
-  std::string s = "[";
-  for (std::size_t i = 0; i < a.size(); ++i) {
-    s += (i ? "," : "") + Str(a[i].get<std::int64_t>());
-  }
-  return s + "]";
-}
-template <typename T>
-std::string Ids(std::span<const T> a) {
-  std::string s = "[";
-  for (std::size_t i = 0; i < a.size(); ++i) {
-    s += (i ? "," : "") + Str(static_cast<std::int64_t>(a[i]));
-  }
-  return s + "]";
-}
-
-ob::CrossingStatus StatusOf(const std::string& s) {
-  if (s == "WARNING") {
-    return ob::CrossingStatus::kWarning;
-  }
-  if (s == "CLOSED") {
-    return ob::CrossingStatus::kClosed;
-  }
-  if (s == "FAILED") {
-    return ob::CrossingStatus::kFailed;
-  }
-  return ob::CrossingStatus::kOpen;
-}
-
-ob::CrossingReport ReportOf(const json& r) {
-  ob::CrossingReport rep{static_cast<std::uint32_t>(I(r, "crossing_id")), StatusOf(r.at("status").get<std::string>()),
-                         I(r, "warning_start_ms"), I(r, "issued_ms"), r.at("clock_fault").get<bool>()};
-  const json& ids = r.at("requesters");  // at most kMaxReportRequesters (ReportOk)
-  for (const json& id : ids) {
-    rep.requesters[rep.requester_count++] = static_cast<std::uint32_t>(id.get<std::int64_t>());
-  }
-  return rep;
-}
-
 ws::ClockInput ClockOf(const std::string& s) {
   if (s == "NO_GNSS") {
     return ws::ClockInput::kNoGnss;
@@ -332,13 +211,6 @@ ws::ClockInput ClockOf(const std::string& s) {
   }
   return ws::ClockInput::kGnss;
 }
-
-std::string ReportString(const ob::CrossingReport& r) {
-  return "{" + Str(r.crossing_id) + "," + ToString(r.status) + ",ws=" + Str(r.warning_start_ms) +
-         ",issued=" + Str(r.issued_ms) + ",cf=" + Bool(r.clock_fault) +
-         ",requesters=" + Ids(std::span<const std::uint32_t>(r.requesters.data(), r.requester_count)) + "}";
-}
-std::string ReportString(const json& r) { return ReportString(ReportOf(r)); }
 
 // One controller cycle and the comparison of its outputs (both variants).
 void StepController(ws::CrossingController& ctl, std::int64_t now, const json& c, bool gnss, Checker& chk) {

@@ -1,8 +1,8 @@
 // The lc vectors for the replays through both units: every lc*.jsonl vector of the pipeline's
 // vector directory, read once per test run with the runners' reader and the lc key list, and
-// the configuration each file's header gives (spec/schemas/vectors_lc.schema.json, as the lc
-// conformance runner reads it): the crossings, the line's permitted speeds, the controllers'
-// and the on-board protection's parameters and the two trains.
+// the configuration each file's header gives (spec/schemas/vectors_lc.schema.json, read and
+// checked by the lc conformance runner's ConfigFromHeader): the crossings, the line's permitted
+// speeds, the controllers' and the on-board protection's parameters and the two trains.
 #pragma once
 
 #include <cstdint>
@@ -16,6 +16,7 @@
 #include "railproof/lc/onboard/crossing_protection.hpp"
 #include "railproof/lc/wayside/crossing_controller.hpp"
 #include "railproof/testing/jsonl_runner.hpp"
+#include "lc/conformance/vector_config.hpp"
 #include "lc/conformance/vector_keys.hpp"
 
 namespace railproof::units::test {
@@ -32,36 +33,28 @@ struct LcFile {
   lc::onboard::ProtectionConfig protection{};
 };
 
-inline LcFile LcHeader(const nlohmann::json& h) {
-  const nlohmann::json& p = h.at("parameters");
-  const auto i64 = [](const nlohmann::json& o, const char* k) { return o.at(k).get<std::int64_t>(); };
-  LcFile f;
-  f.gnss = h.at("variant").get<std::string>() == "GNSS";
-  const nlohmann::json& t = p.at("train");
-  f.train_id = t.at("id").get<std::uint32_t>();
-  f.other_train_id = p.at("other_train_id").get<std::uint32_t>();
-  f.train_length_mm = i64(t, "length_mm");
-  f.accel_max_mm_s2 = i64(t, "accel_max_mm_s2");
-  for (const nlohmann::json& x : p.at("crossings")) {
-    f.crossings.push_back(lc::CrossingData{x.at("id").get<std::uint32_t>(), i64(x, "near_mm"), i64(x, "far_mm"),
-                                           i64(x, "warning_time_ms")});
+// A file's header through the lc runner's reading of it (its checks included), and the other
+// train's id, which that runner does not use; "" or the reason the header is unusable.
+inline std::string LcHeader(const nlohmann::json& h, LcFile& f) {
+  lc::conformance::FileConfig cfg;
+  if (std::string e = lc::conformance::ConfigFromHeader(h, cfg); !e.empty()) {
+    return e;
   }
-  for (const nlohmann::json& x : p.at("restrictions")) {
-    f.restrictions.push_back(core::RestrictionSegment{i64(x, "begin_mm"), i64(x, "end_mm"), i64(x, "limit_mm_s")});
+  const nlohmann::json& p = h["parameters"];
+  if (!lc::conformance::IsInt(p, "other_train_id") || cfg.controllers.empty()) {
+    return "header needs an integer other_train_id and a crossing";
   }
-  const nlohmann::json& c = p.at("controller");
-  f.controller = lc::wayside::DefaultControllerConfig(0);
-  f.controller.barrier_lowering_ms = i64(c, "barrier_lowering_ms");
-  f.controller.barrier_timeout_ms = i64(c, "barrier_timeout_ms");
-  f.controller.max_warning_ms = i64(c, "max_warning_ms");
-  f.controller.holdover_max_ms = i64(c, "holdover_max_ms");
-  const nlohmann::json& pr = p.at("protection");
-  f.protection = lc::onboard::DefaultProtectionConfig(f.train_id, f.train_length_mm, f.accel_max_mm_s2);
-  f.protection.request_lead_ms = i64(pr, "request_lead_ms");
-  f.protection.confirmation_max_age_ms = i64(pr, "confirmation_max_age_ms");
-  f.protection.protection_offset_mm = i64(pr, "protection_offset_mm");
-  f.protection.lookahead_mm = i64(pr, "lookahead_mm");
-  return f;
+  f.gnss = cfg.gnss;
+  f.train_id = cfg.protection.train_id;
+  f.other_train_id = static_cast<std::uint32_t>(lc::conformance::I(p, "other_train_id"));
+  f.train_length_mm = cfg.protection.train_length_mm;
+  f.accel_max_mm_s2 = cfg.protection.accel_max_mm_s2;
+  f.crossings = cfg.crossings;
+  f.restrictions = cfg.restrictions;
+  f.controller = cfg.controllers.front();
+  f.controller.crossing_id = 0;
+  f.protection = cfg.protection;
+  return "";
 }
 
 struct LcVectors {
@@ -77,8 +70,7 @@ inline const LcVectors& LcVectorSet() {
     s.error = conformance::ReadVectorDirectory(
         RAILPROOF_UNITS_VECTORS, "lc", conformance::LcVectorKeys(),
         [&](const std::string& file, const nlohmann::json& h) {
-          s.files[file] = LcHeader(h);
-          return std::string();
+          return LcHeader(h, s.files[file]);
         },
         [&](const conformance::VectorLineRef& line) {
           s.vectors.push_back(

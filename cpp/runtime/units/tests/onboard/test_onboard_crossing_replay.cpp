@@ -85,21 +85,14 @@ std::set<std::uint32_t> IdSet(const json& a) {
   return s;
 }
 
-std::string Str(const std::set<std::uint32_t>& s) {
-  std::string out = "[";
-  for (const std::uint32_t x : s) {
-    out += (out.size() > 1 ? "," : "") + std::to_string(x);
-  }
-  return out + "]";
-}
-
 // The crossing protection's outputs at a tick, the model's or the unit's.
 struct Protection {
   std::optional<std::int64_t> limit_mm;
   std::set<std::uint32_t> requests;
   std::set<std::uint32_t> withdrawals;
   [[nodiscard]] std::string Text() const {
-    return "limit " + rc::OptInt(limit_mm) + " requests " + Str(requests) + " withdrawals " + Str(withdrawals);
+    return "limit " + rc::OptInt(limit_mm) + " requests " + lc::conformance::Ids(requests) +
+           " withdrawals " + lc::conformance::Ids(withdrawals);
   }
   bool operator==(const Protection&) const = default;
 };
@@ -115,23 +108,12 @@ bool SafeSide(const Protection& unit, const Protection& model) {
                        unit.withdrawals.end());
 }
 
+// A vector's report in the unit's clock: an open crossing has no warning start (0), every
+// other time is shifted.
 messages::CrossingReport ReportOf(const json& r, std::int64_t shift_ms) {
-  messages::CrossingReport rep{};
-  rep.crossing_id = r.at("crossing_id").get<std::uint32_t>();
-  const std::string status = r.at("status").get<std::string>();
-  for (const auto s : {messages::CrossingStatus::kOpen, messages::CrossingStatus::kWarning,
-                       messages::CrossingStatus::kClosed, messages::CrossingStatus::kFailed}) {
-    if (status == messages::ToString(s)) {
-      rep.status = s;
-    }
-  }
-  // an open crossing has no warning start (0); every other time is the unit's clock
-  rep.warning_start_ms = rep.status == messages::CrossingStatus::kOpen ? 0 : I(r, "warning_start_ms") + shift_ms;
-  rep.issued_ms = I(r, "issued_ms") + shift_ms;
-  rep.clock_fault = r.at("clock_fault").get<bool>();
-  for (const json& id : r.at("requesters")) {
-    rep.requesters[rep.requester_count++] = id.get<std::uint32_t>();
-  }
+  messages::CrossingReport rep = lc::conformance::ReportOf(r);
+  rep.warning_start_ms = rep.status == messages::CrossingStatus::kOpen ? 0 : rep.warning_start_ms + shift_ms;
+  rep.issued_ms += shift_ms;
   return rep;
 }
 

@@ -1,6 +1,9 @@
-// Test support of the wayside unit: link keys, a small line, and the train's end of a radio
-// link (a train-role telegram endpoint that sends bundles and opens the unit's frames).
+// Test support of the wayside unit's GoogleTest tests: link keys, a small line, and the train's
+// end of a radio link (a train-role telegram endpoint that sends bundles and opens the unit's
+// frames).
 #pragma once
+
+#include <gtest/gtest.h>
 
 #include <array>
 #include <cstdint>
@@ -61,9 +64,9 @@ class TrainRadio {
     config.role = tg::Role::kTrain;
     config.own_id = radio_id;
     config.peer_id = ground_id;
-    init_ = endpoint_.Init(config, tg::LinkKey(KeyOf(train_id)));
+    const tg::ConfigError init = endpoint_.Init(config, tg::LinkKey(KeyOf(train_id)));
+    EXPECT_EQ(init, tg::ConfigError::kNone) << "train " << train_id << ": " << tg::ToString(init);
   }
-  [[nodiscard]] bool Ok() const { return init_ == tg::ConfigError::kNone; }
 
   // One telegram carrying the messages (a plain payload for one).
   std::vector<std::uint8_t> Send(std::int64_t now_ms, std::initializer_list<messages::Message> ms) {
@@ -95,7 +98,6 @@ class TrainRadio {
  private:
   std::uint32_t train_id_;
   tg::Endpoint endpoint_;
-  tg::ConfigError init_ = tg::ConfigError::kNone;
   tg::RejectReason last_reason_ = tg::RejectReason::kNone;
 };
 
