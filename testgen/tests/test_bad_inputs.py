@@ -244,9 +244,13 @@ def test_a_timetable_of_mixed_stops_is_checked_in_linear_time(tmp_path, cli):
 # --------------------------------------------------------------------------- ranges
 
 @pytest.mark.parametrize("file, edit, entry, reason", [
-    ("scenarios/d1_faults.json", lambda o: o.setdefault("supervision", {}).__setitem__("margin_m", 1e300),
-     "supervision", "margin_m: 1e+300 is greater than the maximum of 1000 (metres, at most "
-                    "1000 m: a margin beyond a kilometre is a block, not a margin)"),
+    ("scenarios/d1_faults.json", lambda o: o["trains"][0].__setitem__(
+        "resistance", {"a0": 1e300, "a1": 0.02, "a2": 0.0003}),
+     "trains[2]", "resistance.a0: 1e+300 is greater than the maximum of 100 (N/kN, at most 100 (a "
+                  "deceleration of 0.1 g from resistance alone))"),
+    # the former supervision stand-in is no key of a scenario any more: refused, not ignored
+    ("scenarios/d1_faults.json", lambda o: o.__setitem__("supervision", {"margin_m": 10}),
+     "-", "Additional properties are not allowed ('supervision' was unexpected)"),
     ("scenarios/d1_faults.json", lambda o: o["trains"][0].__setitem__("initial_front_m", 1e12),
      "trains[2]", "initial_front_m: 1000000000000.0 is greater than the maximum of 1000000 "
                   "(metres on the running line, 0 to 1000 km (the longest line of the line "

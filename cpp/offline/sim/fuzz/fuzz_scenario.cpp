@@ -6,9 +6,8 @@
 // "<file>: <entry>: <reason>", no crash and no undefined behaviour (ASan+UBSan), and an
 // accepted scenario is one the simulation models: times within the run (every train departs
 // and every fault begins before the end, so nothing is silently dropped), positions within
-// the line coordinate range (converted to mm without leaving the integers), the supervision
-// stand-in and the channel within their ranges (finite braking curves: the supervision is
-// never switched off), unique train ids other than the ground's, steps dividing the cycles.
+// the line coordinate range (converted to mm without leaving the integers), the channel within
+// its ranges, unique train ids other than the ground's, steps dividing the cycles.
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
@@ -57,9 +56,6 @@ void CheckAccepted(const sim::Scenario& sc) {
   Require(sc.step_ms >= 1 && sc.step_ms <= 1000 && sc.ground_cycle_ms % sc.step_ms == 0 &&
               sc.report_period_ms % sc.step_ms == 0,
           "step dividing the cycles");
-  Require(Finite(sc.supervision.margin_m, 0.0, 1000.0) && Finite(sc.supervision.free_running_s, 0.0, 60.0) &&
-              Finite(sc.supervision.emergency_free_running_s, 0.0, 60.0),
-          "supervision stand-in within its ranges");
   Require(Finite(sc.handover_secure_ahead_m, 0.0, 1e7), "handover look-ahead within the line range");
   Require(Finite(sc.channel.loss_probability, 0.0, 1.0) && Finite(sc.channel.corrupt_probability, 0.0, 1.0) &&
               sc.channel.min_delay_ms >= 0 && sc.channel.min_delay_ms <= sc.channel.max_delay_ms &&

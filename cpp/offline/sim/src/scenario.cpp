@@ -37,19 +37,15 @@ const char* ToString(FaultType type) {
 namespace {
 
 // The ranges of the reader. Times: spec/schemas/scenario.schema.json ($defs/time, at most a
-// week). The schema states no upper bound for the positions, the supervision stand-in and the
-// running resistance; these ranges are stated here: positions within the runtime's line
-// coordinate range (core::kMaxPositionMm, 10,000 km), the supervision margin at most 1 km and
-// its free-running times at most the runtime's supervision times (core::kMaxTimeMs, 60 s), the
-// resistance terms at most 100 N/kN, 10 N/kN per km/h and 1 N/kN per (km/h)^2. Beyond them a
-// value is no longer a scenario the simulation models: near the largest double the braking
-// curves become NaN and would switch the supervision off, and a conversion to mm or ms would
-// leave the integers.
+// week). The schema states no upper bound for the positions and the running resistance; these
+// ranges are stated here: positions within the runtime's line coordinate range
+// (core::kMaxPositionMm, 10,000 km), the resistance terms at most 100 N/kN, 10 N/kN per km/h
+// and 1 N/kN per (km/h)^2. Beyond them a value is no longer a scenario the simulation models:
+// a conversion to mm or ms would leave the integers, and the motion near the largest double
+// would not be finite.
 constexpr double kMaxDurationS = 7.0 * 24.0 * 3600.0;
 constexpr NumberRange kTime{0.0, kMaxDurationS};
 constexpr NumberRange kPosition{0.0, static_cast<double>(core::kMaxPositionMm) / 1000.0};
-constexpr NumberRange kSupervisionMargin{0.0, 1000.0};
-constexpr NumberRange kFreeRunning{0.0, static_cast<double>(core::kMaxTimeMs) / 1000.0};
 constexpr NumberRange kSpeed{0.0, 400.0, true};  // km/h
 
 double Positive(const JsonNode& n, double max) { return n.NumberIn({0.0, max, true}); }
@@ -235,17 +231,6 @@ Scenario ParseScenario(std::string_view text, const std::string& file) {
     }
     if (sc.channel.max_delay_ms < sc.channel.min_delay_ms) {
       mx.Fail("max_delay_ms must lie in [min_delay_ms, 60000], got " + std::to_string(sc.channel.max_delay_ms));
-    }
-  }
-  if (auto sv2 = root.OptKey("supervision")) {
-    if (auto m = sv2->OptKey("margin_m")) {
-      sc.supervision.margin_m = m->NumberIn(kSupervisionMargin, "m");
-    }
-    if (auto m = sv2->OptKey("free_running_s")) {
-      sc.supervision.free_running_s = m->NumberIn(kFreeRunning, "s");
-    }
-    if (auto m = sv2->OptKey("emergency_free_running_s")) {
-      sc.supervision.emergency_free_running_s = m->NumberIn(kFreeRunning, "s");
     }
   }
 

@@ -39,12 +39,12 @@ void Simulation::Impl::CheckInvariants() {
     const units::OnboardOutputs& o = *t.Out();
     const std::string id = std::to_string(t.spec.id);
     // ASM-013: the true front never passes the limit the unit supervises (the movement
-    // authority or the crossing protection limit; none: the unit demands standstill)
-    ++checks["ASM-013"].checks;
-    // authority or the crossing protection limit; none: the unit demands standstill). A limit
-    // that appears behind a standing train (a unit before its first valid position supervises
+    // authority or the crossing protection limit; none: the unit demands standstill; the
+    // patterns include the cycle and reaction times, so no allowance). A limit that appears
+    // behind a standing train (a unit before its first valid position supervises
     // the first crossing of the line) is not passed: the train has to move beyond it.
-    if (o.indications.limit_mm && t.motion.position > ToM(*o.indications.limit_mm) + kLimitToleranceM &&
+    ++checks["ASM-013"].checks;
+    if (o.indications.limit_mm && t.motion.position > ToM(*o.indications.limit_mm) &&
         t.motion.position > t.previous_front_m) {
       Violate("ASM-013", id,
               "train " + id + " front " + Fmt(t.motion.position) + " m beyond its supervised limit " +

@@ -114,12 +114,8 @@ nlohmann::ordered_json Simulation::Summary() const {
                       {"max_delay_ms", s.sc.channel.max_delay_ms},
                       {"corrupt_probability", s.sc.channel.corrupt_probability}};
   // the supervision is the on-board unit's (br::PatternCalculator with the train type's data and
-  // spec/parameters/br.yaml); the scenario's former stand-in values are no longer used
-  j["supervision"] = Json{{"margin_m", s.sc.supervision.margin_m},
-                          {"free_running_s", s.sc.supervision.free_running_s},
-                          {"emergency_free_running_s", s.sc.supervision.emergency_free_running_s},
-                          {"limit_tolerance_m", kLimitToleranceM},
-                          {"by", "on-board unit (br patterns)"},
+  // spec/parameters/br.yaml)
+  j["supervision"] = Json{{"by", "on-board unit (br patterns)"},
                           {"cycle_ms", params::br::cycle_ms},
                           {"service_offset_m", ToM(params::br::service_offset_mm)}};
   std::uint64_t nviol = 0;

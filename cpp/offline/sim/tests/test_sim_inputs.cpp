@@ -232,15 +232,11 @@ TEST(SimScenarioFile, BadScenarioFilesGiveOneLineErrorsNamingTheEntry) {
 }
 
 // Huge but finite values: refused before a conversion to mm or ms, and before they can turn
-// the braking curves into NaN (the supervision off) or put a train or a fault after the end
+// the motion into NaN or put a train or a fault after the end
 // of the run, where it would silently never act while the run reports PASS.
 TEST(SimScenarioFile, HugeValuesAndTimesAfterTheEndAreRefused) {
   ExpectScenarioError([](auto& j) { j["trains"][0]["initial_front_m"] = 1e300; },
                       {"bad_scenario.json: trains[0].initial_front_m: value 1e+300 m is outside [0, 1e+07]"});
-  ExpectScenarioError([](auto& j) { j["supervision"] = {{"emergency_free_running_s", 1e300}}; },
-                      {"bad_scenario.json: supervision.emergency_free_running_s: value 1e+300 s is outside [0, 60]"});
-  ExpectScenarioError([](auto& j) { j["supervision"] = {{"margin_m", 1e9}}; },
-                      {"bad_scenario.json: supervision.margin_m: value 1e+09 m is outside [0, 1000]"});
   ExpectScenarioError([](auto& j) { j["handover_secure_ahead_m"] = 1e300; },
                       {"bad_scenario.json: handover_secure_ahead_m: value 1e+300 m is outside [0, 1e+07]"});
   ExpectScenarioError([](auto& j) { j["trains"][0]["resistance"] = {{"a0", 1.5}, {"a1", 0.02}, {"a2", 1e300}}; },

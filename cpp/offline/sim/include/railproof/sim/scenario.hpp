@@ -67,13 +67,6 @@ struct ChannelSpec {
   double corrupt_probability = 0.0;  // a telegram gets 1..12 symbol errors in one RS block
 };
 
-// Braking supervision stand-in (until the braking issue): see dynamics.hpp Supervision.
-struct SupervisionSpec {
-  double margin_m = 10.0;              // service curve origin short of the stop limit
-  double free_running_s = 1.0;         // included in the service curve
-  double emergency_free_running_s = 0.5;
-};
-
 // Gap measurement between a leader and its follower (the D5 field-test reproduction).
 struct GapSpec {
   std::uint16_t leader = 0;
@@ -97,7 +90,6 @@ struct Scenario {
   std::int64_t report_period_ms = 0;  // default: parameter report_period_ms
   MarginPolicy margin_policy = MarginPolicy::kReported;
   ChannelSpec channel;
-  SupervisionSpec supervision;
   std::int64_t sample_ms = 1000;  // diagram / time series resolution
   double handover_secure_ahead_m = 2000.0;  // radio channel secured this far ahead of a train
   bool boundary_accepted = true;            // the neighbour accepts trains at the system boundary

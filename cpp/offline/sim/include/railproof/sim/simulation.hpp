@@ -62,9 +62,6 @@ namespace railproof::sim {
 // the shared offline pieces (line and train data, JSON, plots, command line)
 using namespace ::railproof::offline;  // NOLINT(google-build-using-namespace)
 
-// Allowance of the ASM-013 check (m): none, the patterns include the cycle and reaction times.
-inline constexpr double kLimitToleranceM = 0.0;
-
 struct Violation {
   std::int64_t t_ms = 0;
   std::string requirement;  // e.g. "REQ-MB-008"
