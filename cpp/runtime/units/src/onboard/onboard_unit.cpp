@@ -86,10 +86,18 @@ ConfigCheck OnboardUnit::Init(const OnboardConfig& c) noexcept {
   }
   last_store_front_mm_ = c.initial_front_mm;
 
-  const std::size_t capacity = std::max({c.line.gradients.size(), MergeCapacity(c.line.speed_limits.size(),
-                                                                                mb::onboard::kStoredRestrictionsMax),
-                                         std::size_t{1}});
-  auto created = br::PatternCalculator::Create(c.train, c.supervision, std::min(capacity, core::kMaxProfileCapacity));
+  // the patterns hold the line's gradients and the merge of its limits with every restriction
+  // the train can hold: a line whose merged profile could not fit is refused here, not at run time
+  const std::size_t merged = MergeCapacity(c.line.speed_limits.size(), mb::onboard::kStoredRestrictionsMax);
+  const std::size_t capacity = std::max({c.line.gradients.size(), merged, std::size_t{1}});
+  if (capacity > core::kMaxProfileCapacity) {
+    ConfigCheck check = Fail(OnboardConfigError::kLineProfile);
+    check.profile.verdict = c.line.gradients.size() > core::kMaxProfileCapacity
+                                ? br::ProfileVerdict::kTooManyGradients
+                                : br::ProfileVerdict::kTooManyRestrictions;
+    return check;
+  }
+  auto created = br::PatternCalculator::Create(c.train, c.supervision, capacity);
   if (created.error != br::CreateError::kNone) {
     ConfigCheck check = Fail(OnboardConfigError::kTrainData);
     check.braking = created.error;
@@ -102,7 +110,6 @@ ConfigCheck OnboardUnit::Init(const OnboardConfig& c) noexcept {
     check.profile = p;
     return check;
   }
-  const std::size_t merged = MergeCapacity(c.line.speed_limits.size(), mb::onboard::kStoredRestrictionsMax);
   if (!profile_.Allocate(merged) || !scratch_.Allocate(merged) || !scratch_.Resize(merged)) {
     return Fail(OnboardConfigError::kOutOfMemory);  // GCOVR_EXCL_LINE defensive
   }
@@ -365,8 +372,9 @@ void OnboardUnit::UpdateProfile() noexcept {
   merged_held_count_ = held.size();
   profile_stale_ = false;
   (void)profile_.Resize(profile_.Capacity());
+  // out and scratch hold MergeCapacity (Init): the merge always fits
   const MergeResult m = MergeRestrictions(line_limits_.Span(), held, profile_.Span(), scratch_.Span());
-  (void)profile_.Resize(m.ok ? m.count : 0);
+  (void)profile_.Resize(m.count);
   out_.profile = patterns_->SetProfile(gradients_.Span(), profile_.Span()).verdict;
 }
 

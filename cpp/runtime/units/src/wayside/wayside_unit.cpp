@@ -35,7 +35,8 @@ ConfigError WaysideUnit::Init(const WaysideConfig& config, CreateResult& result)
   tg::EndpointConfig radio = config.radio;
   radio.role = tg::Role::kGround;
   radio.own_id = config.radio_id;
-  radio.peer_id = static_cast<std::uint16_t>(config.radio_id + 1U);  // any other id: the trains' come at Admit
+  // validated with some peer other than itself: the trains' ids come at Admit
+  radio.peer_id = static_cast<std::uint16_t>(config.radio_id == 0xFFFFU ? 0U : config.radio_id + 1U);
   result.radio_error = tg::Validate(radio);
   if (result.radio_error != tg::ConfigError::kNone) {
     return ConfigError::kRadioInvalid;

@@ -71,6 +71,18 @@ TEST(OnboardUnitConfig, RefusesEachBadPartWithItsReason) {
     EXPECT_TRUE(r.check.profile.in_restrictions);
   }
   {
+    // more line limits than a profile merged with every restriction the train can hold fits
+    Line big;
+    big.limits.clear();
+    const auto n = static_cast<std::int64_t>(core::kMaxProfileCapacity / 2);
+    for (std::int64_t i = 0; i < n; ++i) {
+      big.limits.push_back({i * 1'000, (i + 1) * 1'000, 20'000});
+    }
+    const auto r = OnboardUnit::Create(Config(big));
+    EXPECT_EQ(r.check.error, OnboardConfigError::kLineProfile);
+    EXPECT_EQ(r.check.profile.verdict, br::ProfileVerdict::kTooManyRestrictions);
+  }
+  {
     Line bad;
     bad.crossings.push_back({6, 2'000'000, 2'010'000, 30'000});
     const auto r = OnboardUnit::Create(Config(bad));

@@ -79,7 +79,8 @@ using KeyProvider = bool (*)(const void* context, std::uint32_t train_id, std::a
 struct WaysideConfig {
   std::uint16_t radio_id = static_cast<std::uint16_t>(params::tg::ground_id);
   // the telegram layer's parameters (role and ids are set per train); DeploymentConfig by default
-  tg::EndpointConfig radio = tg::DeploymentConfig(tg::Role::kGround, 1, 2);
+  tg::EndpointConfig radio = tg::DeploymentConfig(tg::Role::kGround, static_cast<std::uint16_t>(params::tg::ground_id),
+                                                 static_cast<std::uint16_t>(params::tg::ground_id + 1));
   KeyProvider keys = nullptr;
   const void* key_context = nullptr;
   // the running line and the ground's capacities; capacity.trains is the base stations'
