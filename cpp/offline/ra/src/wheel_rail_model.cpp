@@ -190,19 +190,10 @@ ra::OdometryConfig OdometryConfigOf(const WheelRailScenario& sc,
   c.wheel_diameter_um =
       std::llround(sc.vehicle.wheel_diameter_m * (1.0 + sc.tg.calibration_error_ppm * 1e-6) * 1e6);
   c.train_length_mm = std::llround(sc.vehicle.length_m * 1000.0);
-  std::int32_t steepest_x10 = 0;
-  for (const auto& s : sections) {
-    steepest_x10 = std::max(steepest_x10, s.gradient_permille_x10);
-  }
-  // Ta never below the gravity component of the steepest gradient plus the TG and IMU
-  // acceleration errors (design note §4, ASM-028): with Ta at the bare gravity component,
-  // sensor noise on the steepest gradient alone raises deviations.
-  const std::int64_t gravity_component =
-      (rp::gravity_mm_s2 * steepest_x10 + 9999) / 10000;  // G * g / 1000, rounded up
-  const std::int64_t floor_mm_s2 =
-      gravity_component + rp::tg_accel_error_mm_s2 + rp::imu_accel_error_mm_s2;
+  // Ta never below its floor on the sections (design note §4, ASM-028)
   c.detect_threshold_mm_s2 =
-      std::max(sc.odometry.detect_threshold_mm_s2.value_or(rp::detect_threshold_mm_s2), floor_mm_s2);
+      std::max(sc.odometry.detect_threshold_mm_s2.value_or(rp::detect_threshold_mm_s2),
+               ra::DetectThresholdFloorMmS2(sections.data(), static_cast<int>(sections.size())));
   c.start_points = static_cast<std::uint8_t>(sc.odometry.start_points.value_or(static_cast<int>(rp::parallel_start_points)));
   c.imu_rate_error_udeg_s = sc.odometry.rate_error_udeg_s.value_or(rp::imu_rate_error_udeg_s);
   c.sections = sections.data();

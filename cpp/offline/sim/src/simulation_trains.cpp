@@ -62,15 +62,10 @@ void Simulation::Impl::CreateUnit(TrainRt& t, std::int64_t front_mm) {
   c.train_id = t.spec.id;
   c.train = ToTrainData(*t.type);
   c.odometry.length_correction_ppm = mbp::length_correction_ppm;
-  // Ta never below gravity on the steepest gradient plus the sensors' acceleration errors
-  // (spec/design/ra.md §4, ASM-028): the sensor model puts gravity into the IMU's a_x.
-  std::int32_t steepest_x10 = 0;
-  for (const auto& s : obl.sections) {
-    steepest_x10 = std::max(steepest_x10, s.gradient_permille_x10);
-  }
-  const std::int64_t floor_mm_s2 = (params::ra::gravity_mm_s2 * steepest_x10 + 9999) / 10000 +
-                                   params::ra::tg_accel_error_mm_s2 + params::ra::imu_accel_error_mm_s2;
-  c.odometry.detect_threshold_mm_s2 = std::max(c.odometry.detect_threshold_mm_s2, floor_mm_s2);
+  // Ta never below its floor on the line's sections (the sensor model puts gravity into a_x)
+  c.odometry.detect_threshold_mm_s2 =
+      std::max(c.odometry.detect_threshold_mm_s2,
+               ra::DetectThresholdFloorMmS2(obl.sections.data(), static_cast<int>(obl.sections.size())));
   c.initial_front_mm = front_mm;
   c.line = units::LineData{obl.blocks_mm, obl.gradients, t.limits, obl.balises, obl.crossings, obl.sections};
   c.crossing = lc::onboard::DefaultProtectionConfig(t.spec.id, t.length_mm, c.train.accel_max_mm_s2);

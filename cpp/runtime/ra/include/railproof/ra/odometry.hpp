@@ -106,6 +106,19 @@ struct OdometryConfig {
   std::int64_t initial_front_mm = 0;          // front at the first cycle (initial balise fix)
 };
 
+// The lowest detection threshold Ta a line's sections allow (design note §4, ASM-028): the
+// gravity component of the steepest gradient (G g / 1000, rounded up) plus the TG and IMU
+// acceleration errors; with Ta at the bare gravity component, sensor noise on the steepest
+// gradient alone raises deviations.
+[[nodiscard]] constexpr std::int64_t DetectThresholdFloorMmS2(const OdometrySection* sections, int count) noexcept {
+  std::int64_t steepest_x10 = 0;
+  for (int i = 0; i < count; ++i) {
+    steepest_x10 = sections[i].gradient_permille_x10 > steepest_x10 ? sections[i].gradient_permille_x10 : steepest_x10;
+  }
+  return (params::ra::gravity_mm_s2 * steepest_x10 + 9999) / 10000 + params::ra::tg_accel_error_mm_s2 +
+         params::ra::imu_accel_error_mm_s2;
+}
+
 enum class ConfigError : std::uint8_t {
   kNone,
   kWheelDiameter,       // not in 500..1500 mm
