@@ -2,11 +2,13 @@
 #include "railproof/offline/line.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <set>
 #include <string>
 #include <utility>
 
 #include "railproof/core/units.hpp"
+#include "railproof/offline/dynamics.hpp"
 #include "railproof/generated/lc_params.hpp"
 #include "railproof/offline/json_reader.hpp"
 
@@ -343,6 +345,54 @@ std::int64_t RunningLine::GradientAt(std::int64_t pos_mm) const {
     }
   }
   return gradients.empty() ? 0 : gradients.back().permille_x10;
+}
+
+namespace {
+
+// ∫ f over [lo, hi] (mm x the value's unit) for a value that is `value(i)` on sections[i].
+template <typename Pieces, typename Value>
+double IntegralOver(const Pieces& pieces, double lo, double hi, Value value) {
+  double sum = 0.0;
+  for (const auto& p : pieces) {
+    const double a = std::max(lo, static_cast<double>(p.section.begin_mm));
+    const double b = std::min(hi, static_cast<double>(p.section.end_mm));
+    if (b > a) {
+      sum += (b - a) * value(p);
+    }
+  }
+  return sum;
+}
+
+}  // namespace
+
+double RunningLine::MeanGradientPermille(double rear_mm, double front_mm) const {
+  const auto permille = [](const Gradient& g) { return static_cast<double>(g.permille_x10) / 10.0; };
+  if (gradients.empty()) {
+    return 0.0;
+  }
+  if (!(front_mm > rear_mm)) {
+    return static_cast<double>(GradientAt(static_cast<std::int64_t>(std::floor(rear_mm)))) / 10.0;
+  }
+  const double begin = static_cast<double>(gradients.front().section.begin_mm);
+  const double end = static_cast<double>(gradients.back().section.end_mm);
+  double sum = IntegralOver(gradients, rear_mm, front_mm, permille);
+  sum += std::max(0.0, std::min(front_mm, begin) - rear_mm) * permille(gradients.front());
+  sum += std::max(0.0, front_mm - std::max(rear_mm, end)) * permille(gradients.back());
+  return sum / (front_mm - rear_mm);
+}
+
+double RunningLine::MeanCurveResistancePermille(double rear_mm, double front_mm) const {
+  if (!(front_mm > rear_mm)) {
+    for (const Curve& c : curves) {
+      if (static_cast<double>(c.section.begin_mm) <= rear_mm && rear_mm < static_cast<double>(c.section.end_mm)) {
+        return CurveResistancePermille(static_cast<double>(c.radius_m));
+      }
+    }
+    return 0.0;
+  }
+  return IntegralOver(curves, rear_mm, front_mm,
+                      [](const Curve& c) { return CurveResistancePermille(static_cast<double>(c.radius_m)); }) /
+         (front_mm - rear_mm);
 }
 
 std::int64_t RunningLine::SpeedLimitAt(std::int64_t pos_mm) const {

@@ -84,6 +84,32 @@ TEST(Dynamics, ConsistResistanceByHand) {
   EXPECT_NEAR(ResistanceDecel(r, 80.0 / 3.6), 9.81 * 4.6454 / 1000.0, 1e-4);
 }
 
+// Curve resistance 800 / R (ASM-034): 2.67 N/kN in a 300 m curve, nothing on straight track.
+TEST(Dynamics, CurveResistanceByHand) {
+  EXPECT_NEAR(CurveResistancePermille(300.0), 800.0 / 300.0, 1e-12);
+  EXPECT_NEAR(CurveResistancePermille(1000.0), 0.8, 1e-12);
+  EXPECT_DOUBLE_EQ(CurveResistancePermille(0.0), 0.0);
+}
+
+// The mean gradient and curve resistance under a 100 m train, by hand: gradients +10 per
+// mille on [0, 500 m) and -5 on [500, 1000 m), a 400 m curve on [600, 700 m).
+TEST(Dynamics, MeanGradientAndCurveResistanceUnderTheTrain) {
+  RunningLine rl;
+  rl.length_mm = 1'000'000;
+  rl.gradients = {Gradient{{0, 500'000}, 100}, Gradient{{500'000, 1'000'000}, -50}};
+  rl.curves = {Curve{{600'000, 700'000}, 400}};
+  EXPECT_DOUBLE_EQ(rl.MeanGradientPermille(300'000.0, 400'000.0), 10.0);
+  EXPECT_DOUBLE_EQ(rl.MeanGradientPermille(450'000.0, 550'000.0), 2.5);  // half on each
+  // beyond the ends the first and last gradients continue
+  EXPECT_DOUBLE_EQ(rl.MeanGradientPermille(-50'000.0, 50'000.0), 10.0);
+  EXPECT_DOUBLE_EQ(rl.MeanGradientPermille(950'000.0, 1'050'000.0), -5.0);
+  EXPECT_DOUBLE_EQ(rl.MeanGradientPermille(500'000.0, 500'000.0), -5.0);  // a point
+  EXPECT_DOUBLE_EQ(rl.MeanCurveResistancePermille(500'000.0, 600'000.0), 0.0);
+  EXPECT_DOUBLE_EQ(rl.MeanCurveResistancePermille(600'000.0, 700'000.0), 2.0);
+  EXPECT_DOUBLE_EQ(rl.MeanCurveResistancePermille(675'000.0, 775'000.0), 0.5);  // a quarter in it
+  EXPECT_DOUBLE_EQ(rl.MeanCurveResistancePermille(650'000.0, 650'000.0), 2.0);
+}
+
 // Traction is constant up to the constant-power speed and falls as 1/v above it; without that
 // speed it stays constant.
 TEST(Dynamics, MaxTractionFallsAboveTheConstantPowerSpeed) {

@@ -110,28 +110,13 @@ Corridor::Corridor(const offline::RunningLine& rl, double from_m, double to_m, c
   std::sort(balises_.begin(), balises_.end());
   const auto n = static_cast<std::size_t>(std::ceil((to_ - from_) / kGridM)) + 1;
   const double length = train.perf.length_m;
-  // ∫ gradient from the line start (per mille x m), exact over the piecewise-constant segments;
-  // before the line start the first segment's gradient continues.
-  auto integral = [&](double x) {
-    double s = 0.0;
-    for (const offline::Gradient& g : rl.gradients) {
-      const double b = static_cast<double>(g.section.begin_mm) / 1000.0;
-      const double e = static_cast<double>(g.section.end_mm) / 1000.0;
-      const double lo = b == 0.0 ? std::min(x, 0.0) : b;
-      const double hi = std::min(x, e);
-      if (hi > lo) {
-        s += (hi - lo) * static_cast<double>(g.permille_x10) / 10.0;
-      }
-    }
-    return s;
-  };
   gradient_.assign(n, 0.0);
   limit_.assign(n, train.perf.max_speed_mps);
   brake_.assign(n, 0.0);
   for (std::size_t i = 0; i < n; ++i) {
     const double x = from_ + static_cast<double>(i) * kGridM;
     if (c == Case::kGradients) {
-      gradient_[i] = (integral(x) - integral(x - length)) / length;
+      gradient_[i] = rl.MeanGradientPermille((x - length) * 1000.0, x * 1000.0);
     }
   }
   if (c == Case::kSpeedLimits) {

@@ -299,8 +299,12 @@ struct Simulation::Impl {
   void CrossingEquipment(const units::CycleOutput& out);
 
   // ---- entry and exit, the on-board unit, the driver, motion and sensors (simulation_trains.cpp)
-  // Length-weighted mean gradient (per mille) under the train [rear, front] (its physics).
+  // Length-weighted mean gradient (per mille) under the train [rear, front]: gravity, which
+  // the IMU also feels.
   [[nodiscard]] double MeanGradient(double rear_m, double front_m) const;
+  // The gradient term of the motion: MeanGradient plus the mean curve resistance under the
+  // train (dynamics.hpp, ASM-034).
+  [[nodiscard]] double MotionGradient(double rear_m, double front_m) const;
   bool EntryClear(const TrainRt& n) const;
   void CreateUnit(TrainRt& t, std::int64_t front_mm);
   void Enter(TrainRt& t);

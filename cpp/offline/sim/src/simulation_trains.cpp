@@ -16,17 +16,11 @@
 namespace railproof::sim {
 
 double Simulation::Impl::MeanGradient(double rear_m, double front_m) const {
-  const std::int64_t a = std::max<std::int64_t>(0, ToMm(rear_m));
-  const std::int64_t b = std::min(rl->length_mm, std::max(a + 1, ToMm(front_m)));
-  double sum = 0.0;
-  for (const auto& g : rl->gradients) {
-    const std::int64_t lo = std::max(a, g.section.begin_mm);
-    const std::int64_t hi = std::min(b, g.section.end_mm);
-    if (hi > lo) {
-      sum += static_cast<double>(hi - lo) * static_cast<double>(g.permille_x10) / 10.0;
-    }
-  }
-  return b > a ? sum / static_cast<double>(b - a) : static_cast<double>(rl->GradientAt(a)) / 10.0;
+  return rl->MeanGradientPermille(rear_m * 1000.0, front_m * 1000.0);
+}
+
+double Simulation::Impl::MotionGradient(double rear_m, double front_m) const {
+  return MeanGradient(rear_m, front_m) + rl->MeanCurveResistancePermille(rear_m * 1000.0, front_m * 1000.0);
 }
 
 bool Simulation::Impl::EntryClear(const TrainRt& n) const {
@@ -277,7 +271,8 @@ Control Simulation::Impl::Drive(TrainRt& t, const units::OnboardOutputs& o, doub
     t.brake = Brake::kDriver;
     return c;
   }
-  const double other = NetAcceleration(p, Control{}, v, MeanGradient(t.motion.position - p.length_m, t.motion.position));
+  const double other =
+      NetAcceleration(p, Control{}, v, MotionGradient(t.motion.position - p.length_m, t.motion.position));
   const double need = (target - v) / kDriverResponseS - other;  // applied acceleration needed
   if (need > 0.0) {
     c.traction_mps2 = std::min(need, p.accel_mps2);
@@ -368,7 +363,7 @@ void Simulation::Impl::MoveTrains() {
                          t.unit->Odometry().stop_reason != ra::StopReason::kStartUp;
     t.odometry_stopped_ms = stopped && !t.position_lost && t.motion.speed <= 0.0 ? t.odometry_stopped_ms + sc.step_ms : 0;
     const Control c = Drive(t, o, dt);
-    const double grad = MeanGradient(t.Rear(), t.motion.position);
+    const double grad = MotionGradient(t.Rear(), t.motion.position);
     const double a = Apply(t, c, grad, dt);
     const Motion before = t.motion;
     t.previous_front_m = before.position;

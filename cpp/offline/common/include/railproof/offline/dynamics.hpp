@@ -9,7 +9,10 @@
 //   r(v)      running resistance a0 + a1 v + a2 v^2 in N/kN (= per mille of the train's
 //             weight), v in km/h (Davis form; SI only); an electric multiple unit's from its
 //             consist by ConsistResistance,
-//   g i/1000  gravity on a gradient of i per mille (+ rising): GradeDecel.
+//   g i/1000  gravity on a gradient of i per mille (+ rising): GradeDecel; curve resistance
+//             enters the same term as an equivalent rising gradient (CurveResistancePermille,
+//             ASM-034), averaged over the train like the gradient (RunningLine's
+//             MeanGradientPermille and MeanCurveResistancePermille, line.hpp).
 // Motion under a constant acceleration is exact: Advance over a time, SpeedAfter and TimeOver
 // over a distance, TimeToCover a distance; a braking or coasting train stops at v = 0 and does
 // not roll back (a standing train holds its brake). Braking curves: StoppingDistance and its
@@ -19,8 +22,9 @@
 // Every offline train motion is this model, each integrated the way its purpose needs:
 //   system simulator (sim)    fixed 100 ms steps (Advance of NetAcceleration) with the driver
 //                             and the real on-board unit in the loop (its brake demand acts on
-//                             the applied acceleration); mean gradient under the train,
-//                             running resistance; SI units, gravity kGravity; the sensor model
+//                             the applied acceleration); mean gradient and mean curve
+//                             resistance under the train, running resistance; SI units,
+//                             gravity kGravity; the sensor model
 //                             derives the odometry's TG and IMU streams from the same motion;
 //   margin verification (br)  the worst case integrated exactly over the pieces of the most
 //                             falling gradient under the train: run-up under traction
@@ -40,7 +44,8 @@
 //   headway study (fc)        fixed time steps (Advance of NetAcceleration, D2 §3) for the leader
 //                             and the follower, with the D2 consist's resistance
 //                             (ConsistResistance) and a constant-power traction region; mean
-//                             gradient under the train; SI units, gravity kGravity.
+//                             gradient under the train; no curve resistance (D2's equation of
+//                             motion has none); SI units, gravity kGravity.
 // Not this model: the Box2D wheel-rail simulator (ra) is multi-body creep physics (car body,
 // bogies, wheelsets, slip-dependent adhesion per wheelset): slip and slide, its subject, do
 // not exist for a point mass.
@@ -107,6 +112,11 @@ struct Motion {
 
 // Resistance deceleration g r(v) / 1000 in m/s^2.
 double ResistanceDecel(const Resistance& r, double speed_mps);
+
+// Curve resistance of a curve of `radius_m` (> 0) in N/kN, that is per mille of the train's
+// weight, the same unit as a rising gradient: 800 / R, the narrow-gauge handbook form
+// (ASM-034).
+double CurveResistancePermille(double radius_m);
 
 // Deceleration by gravity on a gradient of `gradient_permille` (+ rising; negative on a
 // falling gradient) in the unit of `gravity`: gravity * i / 1000.

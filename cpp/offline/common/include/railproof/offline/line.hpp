@@ -125,6 +125,14 @@ struct RunningLine {
   // Gradient (permille x10) and line speed limit (km/h) at a position (clamped to the line).
   [[nodiscard]] std::int64_t GradientAt(std::int64_t pos_mm) const;
   [[nodiscard]] std::int64_t SpeedLimitAt(std::int64_t pos_mm) const;
+  // The mean gradient (per mille, + rising) over a train occupying [rear_mm, front_mm]: what
+  // a point-mass train of that extent feels (dynamics.hpp). Beyond the line's ends its first
+  // and last gradients continue; an extent of zero length gives the gradient at the point.
+  [[nodiscard]] double MeanGradientPermille(double rear_mm, double front_mm) const;
+  // The mean curve resistance (per mille of the train's weight, CurveResistancePermille) over
+  // [rear_mm, front_mm]: each curve's resistance weighted by the part of the train in it;
+  // straight track beyond the curves.
+  [[nodiscard]] double MeanCurveResistancePermille(double rear_mm, double front_mm) const;
   [[nodiscard]] const Station* FindStation(std::string_view name) const;
   [[nodiscard]] const Points* FindPoints(std::string_view points_id) const;
 
