@@ -340,6 +340,32 @@ JsonDocument::JsonDocument(std::string_view text, const std::string& file, std::
   }
 }
 
+std::vector<std::filesystem::path> ListJsonFiles(const std::filesystem::path& path, std::string_view what) {
+  namespace fs = std::filesystem;
+  const std::string name(what);
+  std::error_code ec;
+  if (fs::is_regular_file(path, ec)) {
+    return {path};
+  }
+  if (!fs::is_directory(path, ec)) {
+    throw InputError(path.string() + ": " + name + ": no such file or directory");
+  }
+  std::vector<fs::path> files;
+  for (const auto& e : fs::directory_iterator(path, ec)) {
+    if (e.is_regular_file() && e.path().extension() == ".json") {
+      files.push_back(e.path());
+    }
+  }
+  if (ec) {
+    throw InputError(path.string() + ": cannot list " + name + ": " + ec.message());
+  }
+  std::sort(files.begin(), files.end());
+  if (files.empty()) {
+    throw InputError(path.string() + ": no " + name + " (*.json)");
+  }
+  return files;
+}
+
 std::string ReadInputFile(const std::filesystem::path& path, std::string_view what) {
   namespace fs = std::filesystem;
   const std::string file = path.string();

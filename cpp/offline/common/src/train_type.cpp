@@ -98,6 +98,14 @@ TrainType LoadTrainType(const std::filesystem::path& path) {
   return ParseTrainType(ReadInputFile(path, "train type"), path.string());
 }
 
+std::vector<TrainType> LoadTrainTypes(const std::filesystem::path& path) {
+  std::vector<TrainType> types;
+  for (const auto& f : ListJsonFiles(path, "train types")) {
+    types.push_back(LoadTrainType(f));
+  }
+  return types;
+}
+
 br::TrainData ToTrainData(const TrainType& t) {
   br::TrainData d;
   d.length_mm = t.length_mm;

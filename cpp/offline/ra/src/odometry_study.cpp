@@ -105,15 +105,10 @@ std::filesystem::path LineOfTrain(const TrainType& t, const std::filesystem::pat
   }
   const std::string prefix = t.name.substr(us + 1) + "_";
   std::vector<std::filesystem::path> found;
-  std::error_code ec;
-  for (const auto& entry : std::filesystem::directory_iterator(lines_dir, ec)) {
-    const std::string f = entry.path().filename().string();
-    if (entry.is_regular_file() && entry.path().extension() == ".json" && f.rfind(prefix, 0) == 0) {
-      found.push_back(entry.path());
+  for (const auto& f : offline::ListJsonFiles(lines_dir, "lines")) {
+    if (f.filename().string().rfind(prefix, 0) == 0) {
+      found.push_back(f);
     }
-  }
-  if (ec) {
-    throw InputError(lines_dir.string() + ": cannot list the line directory (" + ec.message() + ")");
   }
   if (found.size() != 1) {
     throw InputError(t.file + ": name: train '" + t.name + "' maps to " + std::to_string(found.size()) +

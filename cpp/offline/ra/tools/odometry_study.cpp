@@ -33,6 +33,7 @@
 #include "railproof/offline/train_type.hpp"
 #include "railproof/generated/ra_params.hpp"
 #include "railproof/offline/cli.hpp"
+#include "railproof/offline/json_reader.hpp"
 #include "railproof/offline/line.hpp"
 #include "railproof/offline/output_file.hpp"
 #include "railproof/ra/analysis/wheel_rail.hpp"
@@ -95,30 +96,6 @@ Options ParseArgs(int argc, char** argv) {
   cli.Add("--quiet", o.quiet, "no progress on stderr");
   cli.ParseOrExit(argc, argv);
   return o;
-}
-
-std::vector<fs::path> ListJson(const fs::path& p, const char* what) {
-  std::vector<fs::path> files;
-  std::error_code ec;
-  if (fs::is_regular_file(p, ec)) {
-    return {p};
-  }
-  if (!fs::is_directory(p, ec)) {
-    throw InputError(p.string() + ": " + what + ": no such file or directory");
-  }
-  for (const auto& e : fs::directory_iterator(p, ec)) {
-    if (e.is_regular_file() && e.path().extension() == ".json") {
-      files.push_back(e.path());
-    }
-  }
-  if (ec) {
-    throw InputError(p.string() + ": cannot list (" + ec.message() + ")");
-  }
-  std::sort(files.begin(), files.end());
-  if (files.empty()) {
-    throw InputError(p.string() + ": no " + what + " (*.json)");
-  }
-  return files;
 }
 
 double R3(double v) { return std::round(v * 1000.0) / 1000.0; }
@@ -469,7 +446,7 @@ int Main(int argc, char** argv) {
   const railproof::offline::Progress progress("odometry_study", o.quiet);
 
   // ---- inputs
-  std::vector<fs::path> files = ListJson(o.scenarios, "wheel-rail scenarios");
+  std::vector<fs::path> files = railproof::offline::ListJsonFiles(o.scenarios, "wheel-rail scenarios");
   if (!o.only.empty()) {
     std::vector<fs::path> keep;
     for (const auto& f : files) {
@@ -488,10 +465,7 @@ int Main(int argc, char** argv) {
   for (const auto& f : files) {
     scenarios.push_back(railproof::ra::analysis::LoadWheelRailScenario(f));
   }
-  std::vector<an::TrainType> trains;
-  for (const auto& f : ListJson(o.trains_dir, "train types")) {
-    trains.push_back(an::LoadTrainType(f));
-  }
+  const std::vector<an::TrainType> trains = an::LoadTrainTypes(o.trains_dir);
   std::vector<an::TrainMarginCheck> train_checks;
   for (const auto& t : trains) {
     train_checks.push_back(an::CheckTrainMargin(t, railproof::offline::LoadLine(an::LineOfTrain(t, o.lines_dir))));

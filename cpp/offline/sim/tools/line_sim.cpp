@@ -6,9 +6,7 @@
 //
 // Exit status: 0 no invariant violated; 1 invariant violations; 2 bad usage or bad input
 // (cli.hpp).
-#include <algorithm>
 #include <chrono>
-#include <filesystem>
 #include <cstdio>
 #include <functional>
 #include <iostream>
@@ -110,31 +108,11 @@ void PrintResult(const Json& s, double wall_s) {
   }
 }
 
-// Every train type of the directory (its *.json files, by name).
-std::vector<railproof::offline::TrainType> LoadTrainTypes(const std::string& dir) {
-  std::vector<std::filesystem::path> files;
-  std::error_code ec;
-  for (const auto& e : std::filesystem::directory_iterator(dir, ec)) {
-    if (e.is_regular_file() && e.path().extension() == ".json") {
-      files.push_back(e.path());
-    }
-  }
-  if (ec) {
-    throw InputError(dir + ": cannot read the train-type directory: " + ec.message());
-  }
-  std::sort(files.begin(), files.end());
-  std::vector<railproof::offline::TrainType> types;
-  for (const auto& f : files) {
-    types.push_back(railproof::offline::LoadTrainType(f));
-  }
-  return types;
-}
-
 int Main(int argc, char** argv) {
   const Options o = ParseArgs(argc, argv);
   const auto base = railproof::sim::LoadScenario(o.scenario);
   const auto line = railproof::offline::LoadLine(railproof::offline::LinePath(o.lines_dir, base.line));
-  const auto types = LoadTrainTypes(o.trains_dir);
+  const auto types = railproof::offline::LoadTrainTypes(o.trains_dir);
   const railproof::offline::Progress progress("line_sim", o.quiet);
   railproof::offline::OutputFiles out;
   for (const std::string& path : {o.summary, o.svg}) {

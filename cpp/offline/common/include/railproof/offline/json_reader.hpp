@@ -131,4 +131,9 @@ class JsonDocument : private json_detail::ParsedJson, public JsonNode {
 // 16777216 bytes"). `what` names the kind of file ("line file"); empty: "file".
 std::string ReadInputFile(const std::filesystem::path& path, std::string_view what);
 
+// The input files of a directory: its *.json files in name order, or `path` itself when it is
+// a file. Otherwise "<path>: <what>: no such file or directory", "<path>: cannot list <what>:
+// <reason>" or "<path>: no <what> (*.json)". `what` names the content ("train types").
+std::vector<std::filesystem::path> ListJsonFiles(const std::filesystem::path& path, std::string_view what);
+
 }  // namespace railproof::offline

@@ -70,6 +70,9 @@ TrainType ParseTrainType(std::string_view text, const std::string& file);
 // @implements REQ-BR-010
 TrainType LoadTrainType(const std::filesystem::path& path);
 
+// Every train type of a directory, or the one file `path` (ListJsonFiles), in name order.
+std::vector<TrainType> LoadTrainTypes(const std::filesystem::path& path);
+
 // The pattern values of the runtime (br::TrainData): the maximum of every range,
 // overspeed in mm/s rounded up.
 br::TrainData ToTrainData(const TrainType& t);
