@@ -191,6 +191,7 @@ class Rig {
 
   [[nodiscard]] std::int64_t Now() const { return stream_.time_ms(); }
   OnboardUnit& Unit() { return *unit_; }
+  [[nodiscard]] const OnboardUnit& Unit() const { return *unit_; }
   Peer& Ground() { return peer_; }
   ra::test::Stream& Sensors() { return stream_; }
   [[nodiscard]] const std::vector<messages::Message>& Heard() const { return heard_; }

@@ -20,21 +20,34 @@
 //       detects, but not a given sequence of those predicates at the model's cycles, so such a
 //       replay would check the stream, not the vector. They are replayed module by module (the
 //       ra runner) only.
-//   br  not replayed: the vectors give abstract pattern speeds (0..6 mm/s), which no position
-//       and stop limit produce through the pattern calculator; the decision with real patterns
-//       is checked in test_onboard_unit.cpp (SupervisesTheSafeFrontOfTheEnvelope).
+//   br  the vectors whose every step has a concrete state (31 of 74): a step's abstract speeds
+//       count only as the set of pattern speeds v_s exceeds (the decision compares nothing
+//       else; the model's equalities and "one above" are not kept). The rig's train stands or
+//       runs at 5 m/s, and the stop limit of each supervision, answered to the telegram before
+//       it, is chosen with the braking module's pattern calculator so that v_s exceeds exactly
+//       that set (checked after the cycle); starts and stops between a standing and a running
+//       step take supervisions of their own, which change nothing the next step reads. Out: the
+//       level, "pattern approaching" and the brake demand. The other 43 ask for pattern speeds
+//       out of the order real ones keep (v_e >= v_7n >= v_6n >= v_5n >= v_4n >= v_release on a
+//       line without restrictions): 7 an emergency pattern below the service one, 36 a lead's
+//       speed above a nearer one's (the model draws each speed independently).
 //   lc  test_onboard_crossing_replay.cpp.
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
+#include "br/conformance/vector_keys.hpp"
 #include "mb/conformance/vector_keys.hpp"
 #include "onboard_rig.hpp"
 #include "ra/conformance/vector_keys.hpp"
+#include "railproof/testing/jsonl_runner.hpp"
 #include "railproof/testing/jsonl_vectors.hpp"
 #include "tg/conformance/vector_reader.hpp"
 #include "../tg_vectors.hpp"
@@ -290,6 +303,234 @@ TEST(OnboardReplay, OdometryVectorsAtStandstill) {
     ++replayed;
   }
   EXPECT_GT(replayed, 0U);
+}
+
+// ---- br ---------------------------------------------------------------------------------------
+
+// On the rig's line, with no restriction near the train and the stop limit ahead, the real
+// pattern speeds are ordered v_e >= v_7n >= v_6n >= v_5n >= v_4n >= v_release: the service
+// pattern falls towards the limit and its leads look ever farther ahead; the emergency pattern
+// brakes harder, with a shorter free-running time, to the limit itself rather than
+// service_offset short of it. So a concrete v_s exceeds the last k of them in that order; a
+// step asking for another set has no concrete state: why not.
+enum class BrGap { kNone, kEmergencyBelowService, kLeadsUnordered };
+
+// The k of a step's exceeded set, or its gap.
+std::pair<int, BrGap> ExceededCount(const rc::BrExceeded& e) {
+  const int k = static_cast<int>(std::count(e.begin(), e.end(), true));
+  for (std::size_t i = 0; i < e.size(); ++i) {
+    if (e[i] != (static_cast<int>(i) >= static_cast<int>(e.size()) - k)) {
+      return {k, e[0] && !e[1] ? BrGap::kEmergencyBelowService : BrGap::kLeadsUnordered};
+    }
+  }
+  return {k, BrGap::kNone};
+}
+
+BrakeDemand DemandOf(const std::string& level) {
+  return level == "NONE" ? BrakeDemand::kNone : level == "EB" ? BrakeDemand::kEmergency : BrakeDemand::kService;
+}
+
+// The rig's train for the br vectors: it stands, or runs at kBrCruise (the TG speed then timed
+// over 100 pulses, steady to a mm/s), and the ground answers every telegram of the unit with a
+// stop limit. The radio period is the supervision cycle, each telegram sent in the cycle before
+// a supervision, so the limit answered to a telegram is the one supervised next.
+constexpr double kBrCruise = 5.0;             // m/s
+constexpr double kBrAccel = 1.0;              // m/s^2, the IMU measuring it (no slip detected)
+constexpr int kBrSettleCycles = 10;           // at the cruising speed: the TG window holds it only
+constexpr std::int64_t kBrFarMm = 2'000'000;  // a limit this far ahead: every pattern above v_s
+
+class BrakingDrive {
+ public:
+  BrakingDrive(const Line& line, const OnboardConfig& c) : rig_(c) {
+    rig_.Start(ra::test::kInitialFrontMm + kBrFarMm);
+    auto created = br::PatternCalculator::Create(c.train, c.supervision);
+    EXPECT_EQ(created.error, br::CreateError::kNone);
+    patterns_.emplace(std::move(*created.calculator));
+    EXPECT_EQ(patterns_->SetProfile(line.gradients, rig_.Unit().Profile()).verdict, br::ProfileVerdict::kAccept);
+    prev_ = Envelope();
+  }
+
+  // Cycles until the train stands (the odometry's standstill) or runs settled at kBrCruise,
+  // then to the cycle that sends the telegram before a supervision. Returns the supervisions
+  // this took, each with the limit far ahead and no reset.
+  int Prepare(bool standing) {
+    int supervisions = 0;
+    for (int n = 0; n < 1'000; ++n) {
+      const double v = rig_.Sensors().speed();
+      const double gap = standing ? -v : kBrCruise - v;
+      const double a = std::fabs(gap) < 1e-9 ? 0.0 : std::clamp(gap / 0.1, -kBrAccel, kBrAccel);
+      settled_ = a == 0.0 && !standing ? settled_ + 1 : 0;
+      const bool there = standing ? rig_.Unit().Odometry().standstill : settled_ > kBrSettleCycles;
+      if (Cycle(a).sent) {
+        if (there) {
+          return supervisions;
+        }
+        rig_.Answer(StopLimit(Next().front_mm + kBrFarMm, rig_.Now()));
+        ++supervisions;
+      }
+    }
+    ADD_FAILURE() << "the train did not " << (standing ? "stop" : "reach its cruising speed");
+    return supervisions;
+  }
+
+  // The stop limit that makes v_s exceed exactly the last k pattern speeds at the next cycle's
+  // envelope and speed (extrapolated from the last two cycles): the middle of the limits that
+  // do, found by bisection (the number exceeded falls as the limit moves ahead); none if none
+  // does.
+  [[nodiscard]] std::optional<std::int64_t> LimitFor(int k) const {
+    const core::PositionEstimate pe = Next();
+    if (k == 0) {
+      return pe.front_mm + kBrFarMm;
+    }
+    const auto exceeded = [&](std::int64_t limit) {
+      const rc::BrExceeded e = rc::BrExceededOf(patterns_->Evaluate(pe, limit).speeds);
+      return static_cast<int>(std::count(e.begin(), e.end(), true));
+    };
+    const auto lowest = [&](int n) {  // the lowest limit ahead with at most n exceeded
+      std::int64_t lo = pe.front_mm;
+      std::int64_t hi = pe.front_mm + kBrFarMm;
+      if (exceeded(lo) <= n) {
+        return lo;
+      }
+      while (hi - lo > 1) {
+        const std::int64_t mid = lo + (hi - lo) / 2;
+        (exceeded(mid) <= n ? hi : lo) = mid;
+      }
+      return hi;
+    };
+    const std::int64_t from = lowest(k);
+    const std::int64_t to = lowest(k - 1);
+    const std::int64_t limit = from + (to - from) / 2;
+    if (from >= to || exceeded(limit) != k) {
+      return std::nullopt;
+    }
+    return limit;
+  }
+
+  // The supervision of a step: the limit answered to the telegram just sent, the driver's
+  // handle and reset in that cycle.
+  const OnboardOutputs& Supervise(std::int64_t limit, const br::DriverInputs& d) {
+    rig_.Answer(StopLimit(limit, rig_.Now()));
+    rig_.Drive(br::DriverInputs{.standstill = false, .handle_emergency = d.handle_emergency, .reset = d.reset});
+    const OnboardOutputs& out = Cycle(0.0);
+    rig_.Drive({});
+    return out;
+  }
+
+  // Which pattern speeds v_s exceeded in the unit's last cycle with this limit (the concrete
+  // state checked against the step's, not the decision).
+  [[nodiscard]] rc::BrExceeded Realised(std::int64_t limit) const {
+    return rc::BrExceededOf(patterns_->Evaluate(Envelope(), limit).speeds);
+  }
+  [[nodiscard]] const ra::OdometryOutput& Odometry() const { return rig_.Unit().Odometry(); }
+
+ private:
+  const OnboardOutputs& Cycle(double a) {
+    ra::test::ImuValues imu;
+    imu.ax = a;
+    prev_ = Envelope();
+    return rig_.Step({a, 0.0}, imu);
+  }
+  [[nodiscard]] core::PositionEstimate Envelope() const { return ra::ToPositionEstimate(rig_.Unit().Odometry()); }
+  [[nodiscard]] core::PositionEstimate Next() const {
+    core::PositionEstimate n = Envelope();
+    n.front_mm += n.front_mm - prev_.front_mm;
+    n.front_error_mm = std::max<std::int64_t>(0, 2 * n.front_error_mm - prev_.front_error_mm);
+    n.rear_error_mm = std::max<std::int64_t>(0, 2 * n.rear_error_mm - prev_.rear_error_mm);
+    return n;
+  }
+
+  Rig rig_;
+  std::optional<br::PatternCalculator> patterns_;
+  core::PositionEstimate prev_{};
+  int settled_ = 0;
+};
+
+// One vector, each step one supervision of the unit. Between a standing step and a running one
+// the train starts or stops over supervisions the model does not have (the limit far ahead, no
+// reset): they keep a latched emergency brake latched and leave the applied level NONE, which
+// the next step reads only through the hold rule (v_s above v_release alone); that step stands
+// (nothing exceeded) or follows a standing one (level NONE already), so the insertion is exact
+// (checked). Out: the supervisor's level, "pattern approaching" and the unit's brake demand
+// (emergency exactly while the model's brake is latched, service for 4N..7N).
+void ReplayBr(const json& steps, std::vector<std::string>& problems) {
+  Line line;
+  line.crossings.clear();  // the limit far ahead governs, not a crossing's protection
+  OnboardConfig c = Config(line);
+  c.radio_period_ms = c.supervision.cycle_ms;
+  c.radio_offset_ms = kOnboardCycleMs;
+  ASSERT_EQ(c.supervision.cycle_ms, 2 * kOnboardCycleMs);
+  BrakingDrive drive(line, c);
+  std::string before = "NONE";
+  for (std::size_t k = 0; k < steps.size() && problems.empty(); ++k) {
+    const json& in = steps[k].at("in");
+    const json& expected = steps[k].at("out");
+    rc::Checker chk(problems, "step " + std::to_string(k) + ": ", &in);
+    const br::DriverInputs d = rc::BrDriverInputsOf(in);
+    const rc::BrExceeded wanted = rc::BrExceededOf(rc::BrPatternSpeedsOf(in));
+    const int n = ExceededCount(wanted).first;
+    if (drive.Prepare(d.standstill) > 0 && n == 1 && DemandOf(before) == BrakeDemand::kService) {
+      chk.Fail("supervisions inserted before a step that reads the level applied before it");
+      return;
+    }
+    const auto limit = drive.LimitFor(n);
+    if (!limit) {
+      chk.Fail("no stop limit makes v_s exceed exactly " + std::to_string(n) + " pattern speeds");
+      return;
+    }
+    const OnboardOutputs& o = drive.Supervise(*limit, d);
+    // the concrete state is the step's
+    chk.Expect("standstill", rc::Bool(d.standstill), rc::Bool(drive.Odometry().standstill));
+    chk.Expect("odometry mode", ra::ToString(ra::Mode::kTg), ra::ToString(drive.Odometry().mode));
+    chk.Expect("governing limit", std::to_string(*limit), rc::OptInt(o.indications.limit_mm));
+    chk.Expect("limit kind", ToString(LimitKind::kMovementAuthority), ToString(o.indications.limit_kind));
+    if (drive.Realised(*limit) != wanted) {
+      chk.Fail("the concrete speeds missed the step's relations (limit " + std::to_string(*limit) + ")");
+    }
+    if (!problems.empty()) {
+      return;
+    }
+    // the unit's outputs against the vector's
+    const std::string level = expected.at("level").get<std::string>();
+    chk.Expect("level", level, br::ToString(o.level));
+    chk.Expect("pattern_approaching", rc::Bool(expected.at("pattern_approaching").get<bool>()),
+               rc::Bool(o.indications.warning));
+    chk.Expect("brake demand (emergency_latched " + rc::Bool(expected.at("emergency_latched").get<bool>()) + ")",
+               ToString(expected.at("emergency_latched").get<bool>() ? BrakeDemand::kEmergency : DemandOf(level)),
+               ToString(o.brake));
+    before = level;
+  }
+}
+
+TEST(OnboardReplay, BrakingVectorsWithConcretePatterns) {
+  const Loaded l = Load("br", rc::BrVectorKeys());
+  std::size_t replayed = 0;
+  std::map<BrGap, std::size_t> gaps;
+  for (const auto& [file, v] : l.vectors) {
+    const json& steps = v.at("steps");
+    BrGap gap = BrGap::kNone;
+    for (std::size_t k = 0; k < steps.size() && gap == BrGap::kNone; ++k) {
+      gap = ExceededCount(rc::BrExceededOf(rc::BrPatternSpeedsOf(steps[k].at("in")))).second;
+    }
+    if (gap != BrGap::kNone) {
+      ++gaps[gap];
+      continue;
+    }
+    SCOPED_TRACE(file + ": " + v.at("id").get<std::string>());
+    std::vector<std::string> problems;
+    ReplayBr(steps, problems);
+    for (const std::string& p : problems) {
+      ADD_FAILURE() << p;
+    }
+    ++replayed;
+  }
+  // The vector set of models/br.pml: every boundary vector, the trap vectors but G21 (EB with
+  // v_s not above v_7n) and G22 (7N with v_s not above v_6n), and 9 of the 50 random walks,
+  // whose pattern speeds are drawn independently.
+  EXPECT_EQ(replayed, 31U);
+  EXPECT_EQ(gaps[BrGap::kEmergencyBelowService], 7U);
+  EXPECT_EQ(gaps[BrGap::kLeadsUnordered], 36U);
+  RecordProperty("replayed", std::to_string(replayed));
 }
 
 }  // namespace
