@@ -31,6 +31,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -309,6 +310,93 @@ WheelRailScenario LoadWheelRailScenario(const std::filesystem::path& path);
 // into `sections` (which must outlive the configuration).
 [[nodiscard]] ra::OdometryConfig OdometryConfigOf(const WheelRailScenario& sc,
                                                         const std::vector<ra::OdometrySection>& sections);
+
+// ---- the vehicle, one step at a time ------------------------------------------------------------
+// The Box2D car of the model summary above as an object advanced one fixed step at a time: the
+// one wheel-rail model. SimulateWheelRail runs it under its driver schedule and records its
+// sensor streams; the system simulator (cpp/offline/sim) runs it under the brake equipment that
+// the real on-board unit commands. Its position is the line chainage of the alignment given.
+struct WheelRailVehicleConfig {
+  VehicleSpec vehicle;
+  VerticalAlignment vertical;
+  RailCondition rail;
+  AdhesionLaw adhesion;
+  SlipControlSpec slip_control;
+  int tg_axle = 1;          // the axle whose rotation the TG count follows (TgCount)
+  int tg_teeth = 90;
+  double tg_phase = 0.5;    // initial angle of the TG wheel, in pulses [0.5, 1)
+  double front_m = 0.0;     // the front at the start (line chainage along the rail)
+  double speed_mps = 0.0;   // initial speed (every wheelset rolling)
+};
+
+// The demands of one step: traction as a notch fraction 0..1 (of max_traction_force_n, power
+// limited), brake as a multiple of the full service brake (max_brake_force_n per axle): 0..1 the
+// service brake, beyond 1 a stronger brake (the emergency brake of a train whose emergency
+// deceleration exceeds its service deceleration). The slip control acts on both.
+struct WheelRailDemand {
+  double traction = 0.0;
+  double brake = 0.0;
+};
+
+// A wheelset at the end of the last step (rail position and speed as of the last update).
+struct WheelsetState {
+  double omega = 0.0;        // rad/s, + rolling forward
+  double normal_n = 0.0;     // N from the last step
+  double friction_n = 0.0;   // static friction force while held (from the last step)
+  double creep = 0.0;
+  double force_n = 0.0;      // creep force applied in the last step
+  double v = 0.0;            // wheelset speed along the rail
+  double s = 0.0;            // rail position of its contact
+  double control = 1.0;      // slip-control torque factor
+  bool hold = false;         // braked standstill held by static friction
+};
+
+class WheelRailVehicle {
+ public:
+  // Builds the car at rest on the rail (or rolling at speed_mps); throws offline::InputError
+  // when the configuration cannot be built.
+  explicit WheelRailVehicle(const WheelRailVehicleConfig& config);
+  ~WheelRailVehicle();
+  WheelRailVehicle(WheelRailVehicle&&) noexcept;
+  WheelRailVehicle& operator=(WheelRailVehicle&&) noexcept;
+  WheelRailVehicle(const WheelRailVehicle&) = delete;
+  WheelRailVehicle& operator=(const WheelRailVehicle&) = delete;
+
+  // The demands from the wheelsets' mean speed along the rail at the start of a step.
+  using Demand = std::function<WheelRailDemand(double speed_mps)>;
+  // One Box2D step of dt_s: t_s is the time of the adhesion zones' windows, t_run_s the time
+  // of the TG edges.
+  void Step(double t_run_s, double t_s, double dt_s, const Demand& demand);
+  // Rail position and speed of every wheelset from the bodies (Step does it at its start).
+  void UpdateWheelsets();
+  // Keeps the rail built around the car (pieces beyond its reach are removed); call it at
+  // least every few metres run.
+  void KeepRailAround();
+
+  [[nodiscard]] double FrontM() const;   // leading axle's contact + overhang, as of the last update
+  [[nodiscard]] double CentreM() const;
+  [[nodiscard]] double SpeedMps() const;  // mean of the wheelsets' speeds along the rail
+  [[nodiscard]] const WheelsetState& Wheelset(int axle) const;
+  [[nodiscard]] double WheelRadiusM() const;
+  // Car body velocity in the vertical plane (x along the unrolled track, z up) and pitch.
+  [[nodiscard]] double BodyVx() const;
+  [[nodiscard]] double BodyVz() const;
+  [[nodiscard]] double BodyPitchRad() const;
+  // TG axle: pulses completed since the start and the time of the latest edge (none yet: nullopt).
+  [[nodiscard]] std::int64_t TgCount() const;
+  [[nodiscard]] std::optional<double> TgEdgeS() const;
+  // The demands of the last step.
+  [[nodiscard]] const WheelRailDemand& LastDemand() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+// The configuration of a scenario's car: its vehicle, alignment, rail, adhesion law, slip
+// control and TG; front and speed at the start (a lead-in's start, SimulateWheelRail).
+[[nodiscard]] WheelRailVehicleConfig VehicleConfigOf(const WheelRailScenario& sc, double front_m, double speed_mps,
+                                                     double tg_phase);
 
 // ---- run --------------------------------------------------------------------------------------
 enum class SlipKind : std::uint8_t { kSlip, kSlide };  // slip: wheel faster (traction), slide: slower
