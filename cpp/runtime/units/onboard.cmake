@@ -4,4 +4,5 @@ railproof_runtime_module(onboard_unit CAPABILITY units SIDE onboard
   SOURCES src/onboard/onboard_unit.cpp src/onboard/onboard_profile.cpp
   LINKS tg mb_onboard br ra lc_onboard messages)
 set(RAILPROOF_UNITS_ONBOARD_TESTS tests/onboard/test_onboard_unit.cpp tests/onboard/test_onboard_profile.cpp
-    tests/onboard/test_onboard_replay.cpp tests/onboard/test_onboard_crossing_replay.cpp)
+    tests/onboard/test_onboard_replay.cpp tests/onboard/test_onboard_crossing_replay.cpp
+    tests/onboard/test_onboard_handover.cpp)

@@ -4,6 +4,7 @@
 #include "railproof/units/onboard_unit.hpp"
 
 #include <algorithm>
+#include <initializer_list>
 #include <limits>
 #include <variant>
 
@@ -130,16 +131,113 @@ ConfigCheck OnboardUnit::Init(const OnboardConfig& c) noexcept {
     return check;
   }
 
-  authority_ = mb::onboard::AuthorityReceiver(c.authority);
+  authority_config_ = c.authority;
   if (c.radio.role != tg::Role::kTrain || !c.link_key) {
     return Fail(OnboardConfigError::kRadio);
   }
-  if (const tg::ConfigError e = endpoint_.Init(c.radio, *c.link_key); e != tg::ConfigError::kNone) {
+  radio_ = c.radio;
+  link_key_.emplace(*c.link_key);
+  if (const ConfigCheck areas = InitAreas(c); areas.error != OnboardConfigError::kNone) {
+    return areas;
+  }
+  // the first link: the area holding the initial front (the last origin at or before it)
+  std::size_t area = 0;
+  while (area + 1 < areas_.Size() && areas_[area + 1].origin_mm <= c.initial_front_mm) {
+    ++area;
+  }
+  if (const tg::ConfigError e = Open(First(), area); e != tg::ConfigError::kNone) {
     ConfigCheck check = Fail(OnboardConfigError::kRadio);
     check.radio = e;
     return check;
   }
+  out_.radio_area = area;
   return {};
+}
+
+// The radio areas (none: one unit with the line's chainage and the configured peer). An
+// origin must be a block boundary: the report to a unit is a block and an offset of its line.
+ConfigCheck OnboardUnit::InitAreas(const OnboardConfig& c) noexcept {
+  const auto areas = c.radio_areas;
+  const auto fail = [](RadioAreaError e, std::size_t entry) {
+    ConfigCheck check = Fail(OnboardConfigError::kRadioAreas, entry);
+    check.areas = e;
+    return check;
+  };
+  for (std::size_t i = 0; i < areas.size(); ++i) {
+    const RadioArea& a = areas[i];
+    if (i > 0 && a.origin_mm <= areas[i - 1].origin_mm) {
+      return fail(RadioAreaError::kNotIncreasing, i);
+    }
+    if (!std::binary_search(blocks_.begin(), blocks_.end(), a.origin_mm) || a.origin_mm == blocks_.Span().back()) {
+      return fail(RadioAreaError::kOriginNotOnBlock, i);
+    }
+    const bool last = i + 1 == areas.size();
+    if (last ? a.boundary_mm.has_value()
+             : !a.boundary_mm || *a.boundary_mm <= areas[i + 1].origin_mm || *a.boundary_mm > blocks_.Span().back()) {
+      return fail(RadioAreaError::kBoundaryOutsideArea, i);
+    }
+    const bool twice = std::any_of(areas.begin(), areas.begin() + static_cast<std::ptrdiff_t>(i),
+                                   [&](const RadioArea& b) { return b.peer_id == a.peer_id; });
+    if (twice || a.peer_id == c.radio.own_id) {
+      return fail(RadioAreaError::kPeerTwice, i);
+    }
+  }
+  const RadioArea single{c.radio.peer_id, 0, std::nullopt};
+  const auto list = areas.empty() ? std::span<const RadioArea>(&single, 1) : areas;
+  if (!areas_.AssignFrom(list, list.size()) || !origin_blocks_.Allocate(list.size())) {
+    return Fail(OnboardConfigError::kOutOfMemory);  // GCOVR_EXCL_LINE defensive
+  }
+  for (const RadioArea& a : list) {
+    const auto at = std::lower_bound(blocks_.begin(), blocks_.end(), a.origin_mm);
+    (void)origin_blocks_.PushBack(static_cast<std::uint32_t>(at - blocks_.begin()));
+  }
+  return {};
+}
+
+// Opens `link` to the unit of `area`: a fresh telegram layer link (the same set-up as at start)
+// and no authority yet.
+tg::ConfigError OnboardUnit::Open(RadioLink& link, std::size_t area) noexcept {
+  tg::EndpointConfig config = radio_;
+  config.peer_id = areas_[area].peer_id;
+  const tg::ConfigError e = link.endpoint.Init(config, *link_key_);
+  if (e == tg::ConfigError::kNone) {
+    link.area = area;
+    link.authority = mb::onboard::AuthorityReceiver(authority_config_);
+    link.obstruction = messages::Obstruction::kNone;
+    link.restriction_count = 0;
+  }
+  return e;
+}
+
+void OnboardUnit::Close(RadioLink& link) noexcept {
+  link.area.reset();
+  link.restriction_count = 0;
+  UpdateRestrictions();
+}
+
+// The one conversion between the line's chainage and a unit's.
+std::int64_t OnboardUnit::ToArea(const RadioLink& link, std::int64_t line_mm) const noexcept {
+  return line_mm - areas_[*link.area].origin_mm;
+}
+
+std::int64_t OnboardUnit::FromArea(const RadioLink& link, std::int64_t area_mm) const noexcept {
+  // the next unit's positions taken as the line's
+  if (RAILPROOF_FAULT(FAULT_UNIT_HANDOVER_NO_ORIGIN) && &link != &links_[first_]) {
+    return area_mm;
+  }
+  return area_mm + areas_[*link.area].origin_mm;
+}
+
+std::optional<std::int64_t> OnboardUnit::BoundaryOf(const RadioLink& link) const noexcept {
+  return link.area ? areas_[*link.area].boundary_mm : std::nullopt;
+}
+
+// The first unit no longer protects the train once its rearmost rear (front - length - rear
+// error) has passed that unit's boundary: past it the next unit's limit governs.
+bool OnboardUnit::Released(const ra::OdometryOutput& o) const noexcept {
+  const auto boundary = BoundaryOf(links_[first_]);
+  return boundary && links_[1 - first_].area && o.position_valid &&
+         o.front_mm - length_mm_ - o.rear_error_mm >= *boundary;
 }
 
 // ---- the cycle -----------------------------------------------------------------------------
@@ -148,6 +246,8 @@ const OnboardOutputs& OnboardUnit::Cycle(const OnboardInputs& in) noexcept {
   out_.now_ms = in.now_ms;
   out_.sent = false;
   out_.frame.size = 0;
+  out_.handover_sent = false;
+  out_.handover_frame.size = 0;
   out_.crossing_messages_sent = 0;
   out_.encode_error = messages::EncodeError::kNone;
   out_.event_count = 0;
@@ -180,6 +280,11 @@ const OnboardOutputs& OnboardUnit::Cycle(const OnboardInputs& in) noexcept {
   }
   restrictions_.Advance(last_store_front_mm_, length_mm_);
 
+  // the links of the handover; this cycle's frames come from the areas the last outputs named
+  const std::size_t frames_area = out_.radio_area;
+  const std::optional<std::size_t> handover_frames_area = out_.handover_area;
+  ManageLinks(o);
+
   // 3. the telegram of this cycle
   if (!next_radio_ms_) {
     next_radio_ms_ = in.now_ms + radio_offset_ms_;
@@ -191,10 +296,12 @@ const OnboardOutputs& OnboardUnit::Cycle(const OnboardInputs& in) noexcept {
   }
 
   // 4. what arrived
-  Receive(in);
-  out_.link = endpoint_.Link();
-  out_.authority_usable = authority_.Usable(in.now_ms);
-  out_.authority_limit_mm = authority_.Limit();
+  Receive(in, frames_area, handover_frames_area);
+  Authority(o);
+  out_.link = LinkDemand(o);
+  out_.handover_link = Second().area ? Second().endpoint.Link() : tg::LinkState::kNone;
+  out_.authority_usable = authority_mm_.has_value();
+  out_.authority_limit_mm = authority_mm_ ? authority_mm_ : First().authority.Limit();
 
   // 5.-7.
   UpdateProfile();
@@ -205,6 +312,71 @@ const OnboardOutputs& OnboardUnit::Cycle(const OnboardInputs& in) noexcept {
   }
   Demand(o);
   return out_;
+}
+
+// The movement authority of the links that count (header comment): the first unit's until it
+// has released the train, then the more restrictive of the next unit's; before the next unit's
+// limit is usable, none past the first unit's boundary.
+void OnboardUnit::Authority(const ra::OdometryOutput& o) noexcept {
+  authority_mm_.reset();
+  obstruction_ = messages::Obstruction::kNone;
+  const RadioLink& first = First();
+  const RadioLink& second = Second();
+  const bool first_counts = !Released(o);
+  if (first_counts) {
+    if (!first.authority.Usable(out_.now_ms) || !first.authority.Limit()) {
+      return;
+    }
+    authority_mm_ = first.authority.Limit();
+    obstruction_ = first.obstruction;
+  }
+  if (!second.area) {
+    return;
+  }
+  if (second.authority.Usable(out_.now_ms) && second.authority.Limit()) {
+    if (!authority_mm_ || *second.authority.Limit() < *authority_mm_) {
+      authority_mm_ = second.authority.Limit();
+      obstruction_ = second.obstruction;
+    }
+  } else if (!first_counts) {
+    authority_mm_.reset();
+    obstruction_ = messages::Obstruction::kNone;
+  } else if (const auto boundary = BoundaryOf(first); *authority_mm_ > *boundary) {
+    authority_mm_ = boundary;
+    obstruction_ = messages::Obstruction::kSystemBoundary;
+  }
+}
+
+// The link state the brake demand reads (REQ-TG-014 in tg): the first link until the train is
+// released, the second once the safe front is past the first unit's boundary.
+tg::LinkState OnboardUnit::LinkDemand(const ra::OdometryOutput& o) const noexcept {
+  const RadioLink& first = links_[first_];
+  const RadioLink& second = links_[1 - first_];
+  if (!Released(o) && first.endpoint.Link() != tg::LinkState::kUp) {
+    return first.endpoint.Link();
+  }
+  const auto boundary = BoundaryOf(first);
+  const bool second_counts = second.area && (!o.position_valid || o.front_mm + o.front_error_mm > *boundary);
+  return second_counts ? second.endpoint.Link() : tg::LinkState::kUp;
+}
+
+// Opens the next unit's link when the front enters the handover zone; drops the first once the
+// train is released and that unit no longer sends (after it removed the train the telegram
+// layer's supervision finds the link lost): the second becomes the first. Runs before the
+// telegram of the cycle, so that the outputs name the areas of this cycle's telegrams and of
+// the next cycle's frames.
+void OnboardUnit::ManageLinks(const ra::OdometryOutput& o) noexcept {
+  RadioLink& second = Second();
+  const std::size_t area = *First().area;
+  if (!second.area && area + 1 < areas_.Size() && o.position_valid && o.front_mm >= areas_[area + 1].origin_mm) {
+    (void)Open(second, area + 1);  // the configuration Create accepted: never refused
+  }
+  if (second.area && Released(o) && First().endpoint.Link() != tg::LinkState::kUp) {
+    Close(First());
+    first_ = 1 - first_;
+  }
+  out_.radio_area = *First().area;
+  out_.handover_area = Second().area;
 }
 
 // The front the restriction store measures the rear from: the rearmost the front may be
@@ -219,20 +391,25 @@ std::int64_t OnboardUnit::StoreFront(const ra::OdometryOutput& o) const noexcept
 // REQ-MB-003), the last balise and the measured speed. No valid position, or a front off the
 // block table: NO_POSITION.
 // @implements REQ-MB-001
-messages::Message OnboardUnit::Report(const ra::OdometryOutput& o) const noexcept {
+// To a unit of a radio area the block counts from the area's origin and the balise is in its
+// chainage; a front before the area is no position for it. A balise behind the origin is
+// reported at the origin (the unit's line does not hold it; the reported correction, the
+// train's own bound, still covers the run from the balise).
+messages::Message OnboardUnit::Report(const ra::OdometryOutput& o, const RadioLink& link) const noexcept {
   const std::int64_t correction = ra::ReportCorrectionMm(o);
   // The envelope's rear end of the front would report the train behind where it may be.
   const std::int64_t front = RAILPROOF_FAULT(FAULT_UNIT_REPORT_UNSAFE_END) ? o.front_mm - correction : o.front_mm;
   const auto at = core::LocateFront(blocks_.Span(), front);
-  if (!o.position_valid || !at) {
+  const std::uint32_t origin_block = origin_blocks_[*link.area];
+  if (!o.position_valid || !at || at->block < origin_block) {
     return messages::NoPosition{};
   }
   return messages::PositionReport{train_id_,
-                                  at->block,
+                                  at->block - origin_block,
                                   at->offset_mm,
                                   length_mm_,
                                   correction,
-                                  o.last_balise_mm,
+                                  std::max<std::int64_t>(0, ToArea(link, o.last_balise_mm)),
                                   o.speed_mm_s,
                                   messages::Direction::kNominal};
 }
@@ -240,9 +417,31 @@ messages::Message OnboardUnit::Report(const ra::OdometryOutput& o) const noexcep
 // One telegram (REQ-TG-008): the report first, then the crossing messages of the last
 // crossing cycle that fit, continuing where the previous telegram stopped (REQ-LC-002,
 // REQ-LC-004: every message repeated until its state changes).
+// With two links each gets its own telegram: its report and the same crossing messages (each
+// unit takes those of its own crossings).
 void OnboardUnit::Send(const ra::OdometryOutput& o) noexcept {
+  tg::Endpoint::CycleOutput sent{};
+  const std::size_t added = SendOn(First(), o, out_.frame, sent);
+  out_.send_status = sent.status;
+  out_.send_link = sent.link;
+  out_.sent = sent.status == tg::SendStatus::kSent;
+  out_.crossing_messages_sent = out_.sent ? added : 0;
+  if (Second().area) {
+    const messages::EncodeError first_error = out_.encode_error;
+    (void)SendOn(Second(), o, out_.handover_frame, sent);
+    out_.handover_sent = sent.status == tg::SendStatus::kSent;
+    out_.encode_error = first_error != messages::EncodeError::kNone ? first_error : out_.encode_error;
+  }
+  const lc::onboard::ProtectionOutput& p = crossings_->Output();
+  const std::size_t pending = p.request_count + p.withdrawal_count;
+  pending_cursor_ = pending == 0 ? 0 : (pending_cursor_ + added) % pending;
+}
+
+// One link's telegram; returns the crossing messages it carries.
+std::size_t OnboardUnit::SendOn(RadioLink& link, const ra::OdometryOutput& o, tg::EncodedFrame& frame,
+                                tg::Endpoint::CycleOutput& sent) noexcept {
   messages::Bundle bundle;
-  (void)bundle.Add(Report(o));
+  (void)bundle.Add(Report(o, link));
   const lc::onboard::ProtectionOutput& p = crossings_->Output();
   const std::size_t pending = p.request_count + p.withdrawal_count;
   std::size_t added = 0;
@@ -255,7 +454,6 @@ void OnboardUnit::Send(const ra::OdometryOutput& o) noexcept {
     }
     ++added;
   }
-  pending_cursor_ = pending == 0 ? 0 : (pending_cursor_ + added) % pending;
   messages::Encoded e = messages::EncodeBundle(bundle.View());
   if (!e.Ok()) {
     // a report the codec refuses (a value out of its range) goes as NO_POSITION, alone
@@ -263,11 +461,8 @@ void OnboardUnit::Send(const ra::OdometryOutput& o) noexcept {
     e = messages::Encode(messages::NoPosition{});
     added = 0;
   }
-  const auto sent = endpoint_.Cycle(static_cast<std::uint32_t>(out_.now_ms), e.payload.View(), out_.frame);
-  out_.send_status = sent.status;
-  out_.send_link = sent.link;
-  out_.sent = sent.status == tg::SendStatus::kSent;
-  out_.crossing_messages_sent = out_.sent ? added : 0;
+  sent = link.endpoint.Cycle(static_cast<std::uint32_t>(out_.now_ms), e.payload.View(), frame);
+  return added;
 }
 
 void OnboardUnit::AddEvent(const RxEvent& e) noexcept {
@@ -278,14 +473,27 @@ void OnboardUnit::AddEvent(const RxEvent& e) noexcept {
 
 // The frames of the cycle through the telegram layer (REQ-TG-001..012 in tg::Endpoint) and
 // the codec; each message to its module.
-void OnboardUnit::Receive(const OnboardInputs& in) noexcept {
+// Each input goes to the link of the area it came from (a link dropped since: not read).
+void OnboardUnit::Receive(const OnboardInputs& in, std::size_t frames_area,
+                          std::optional<std::size_t> handover_frames_area) noexcept {
   report_count_ = 0;
   ack_count_ = 0;
-  const std::size_t n = std::min(in.frames.size(), kMaxFramesPerCycle);
+  for (RadioLink& link : links_) {
+    if (link.area && *link.area == frames_area) {
+      ReceiveOn(link, in.frames, 0, in.now_ms);
+    } else if (link.area && link.area == handover_frames_area) {
+      ReceiveOn(link, in.handover_frames, in.frames.size(), in.now_ms);
+    }
+  }
+}
+
+void OnboardUnit::ReceiveOn(RadioLink& link, std::span<const std::span<const std::uint8_t>> frames,
+                            std::size_t first_index, std::int64_t now_ms) noexcept {
+  const std::size_t n = std::min(frames.size(), kMaxFramesPerCycle);
   for (std::size_t f = 0; f < n; ++f) {
     RxEvent event;
-    event.frame = f;
-    const auto r = endpoint_.Receive(static_cast<std::uint32_t>(in.now_ms), in.frames[f], rx_payload_);
+    event.frame = first_index + f;
+    const auto r = link.endpoint.Receive(static_cast<std::uint32_t>(now_ms), frames[f], rx_payload_);
     event.gap = r.gap;
     event.link = r.link;
     if (r.reason != tg::RejectReason::kNone) {
@@ -306,18 +514,34 @@ void OnboardUnit::Receive(const OnboardInputs& in) noexcept {
     }
     for (std::size_t k = 0; k < d.bundle.size; ++k) {
       event.entry = k;
-      OnMessage(d.bundle.messages[k], event);
+      OnMessage(link, d.bundle.messages[k], event);
     }
   }
-  if (in.frames.size() > n) {
+  if (frames.size() > n) {
     RxEvent dropped;
     dropped.status = RxStatus::kFramesDropped;
-    dropped.entry = in.frames.size() - n;
+    dropped.frame = first_index;
+    dropped.entry = frames.size() - n;
     AddEvent(dropped);
   }
 }
 
-void OnboardUnit::OnMessage(const messages::Message& m, RxEvent event) noexcept {
+// The store holds the restrictions of both links' last telegrams (each unit sends those of its
+// own line; together they fit the store: kStoredRestrictionsMax is two telegrams').
+void OnboardUnit::UpdateRestrictions() noexcept {
+  std::array<messages::SpeedRestriction, mb::onboard::kStoredRestrictionsMax> all{};
+  std::size_t n = 0;
+  for (const std::size_t k : {first_, 1 - first_}) {
+    const RadioLink& link = links_[k];
+    for (std::size_t i = 0; i < link.restriction_count && n < all.size(); ++i) {
+      all[n++] = link.restrictions[i];
+    }
+  }
+  (void)restrictions_.Update(std::span<const messages::SpeedRestriction>(all.data(), n), last_store_front_mm_,
+                             length_mm_);
+}
+
+void OnboardUnit::OnMessage(RadioLink& link, const messages::Message& m, RxEvent event) noexcept {
   event.type = messages::TypeOf(m);
   if (const auto* t = std::get_if<messages::StopLimitTelegram>(&m)) {
     if (t->train_id != train_id_) {
@@ -325,13 +549,18 @@ void OnboardUnit::OnMessage(const messages::Message& m, RxEvent event) noexcept 
     } else {
       // REQ-MB-009 (AuthorityReceiver), then the restrictions of the accepted telegram
       // (REQ-MB-015, SpeedRestrictionStore)
-      event.verdict = authority_.Receive(t->limit_mm, t->issue_time_ms, out_.now_ms);
+      event.verdict = link.authority.Receive(FromArea(link, t->limit_mm), t->issue_time_ms, out_.now_ms);
       event.status = event.verdict == mb::onboard::Verdict::kAccept ? RxStatus::kAccepted : RxStatus::kStopLimitRefused;
       if (event.verdict == mb::onboard::Verdict::kAccept) {
-        obstruction_ = t->kind;
-        const std::size_t count = std::min<std::size_t>(t->restriction_count, t->restrictions.size());
-        (void)restrictions_.Update(std::span<const messages::SpeedRestriction>(t->restrictions.data(), count),
-                                   last_store_front_mm_, length_mm_);
+        link.obstruction = t->kind;
+        link.restriction_count = std::min<std::size_t>(t->restriction_count, t->restrictions.size());
+        for (std::size_t i = 0; i < link.restriction_count; ++i) {
+          messages::SpeedRestriction r = t->restrictions[i];
+          r.begin_mm = FromArea(link, r.begin_mm);
+          r.end_mm = FromArea(link, r.end_mm);
+          link.restrictions[i] = r;
+        }
+        UpdateRestrictions();
       }
     }
   } else if (std::holds_alternative<messages::KeepAlive>(m)) {
@@ -414,8 +643,8 @@ void OnboardUnit::Supervise(const ra::OdometryOutput& o, const br::DriverInputs&
   Indications& ind = out_.indications;
   ind = Indications{};
   std::optional<std::int64_t> limit;
-  if (authority_.Usable(out_.now_ms) && authority_.Limit()) {
-    limit = authority_.Limit();
+  if (authority_mm_) {
+    limit = authority_mm_;
     ind.limit_kind = LimitKind::kMovementAuthority;
     ind.obstruction = obstruction_;
     const auto& p = crossings_->Output();

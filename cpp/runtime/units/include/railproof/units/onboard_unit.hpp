@@ -21,6 +21,24 @@
 // arrived, as the telegram model orders them): crossing messages decided in a cycle leave
 // with the next telegram.
 //
+// Handover between wayside units (OnboardConfig::radio_areas; spec/design/units.md). The
+// line may be served by several wayside units, each from its origin on (its own chainage
+// starts there) to past its system boundary; the next unit's origin lies before that
+// boundary and begins the handover zone. The unit holds two preallocated links:
+//   - the first, to the unit of the area the train is in; the second is opened (the same
+//     telegram layer set-up) when the front enters the zone before the first's boundary;
+//   - while both are open the train reports to both, each report in that unit's chainage
+//     (ToArea/FromArea: the one conversion), and obeys the more restrictive limit; without a
+//     usable limit of the next unit it obeys no limit past the boundary, and its link counts
+//     for the brake demand only once the safe front is past the boundary;
+//   - once the rearmost rear has passed the boundary the first unit's limit and link no
+//     longer count; the first link is dropped when it is no longer up (the releasing unit
+//     removes the train once its extended rear has passed and then stops sending to it), and
+//     the second becomes the first.
+// The outputs name the area of each telegram sent (radio_area: `frame`, handover_area:
+// `handover_frame`); the next cycle's `frames` and `handover_frames` are those of the same
+// areas' units.
+//
 // Runtime rules: all storage allocated by Create, none after; no exceptions; typed errors for
 // the configuration and for every rejected input; deterministic (same inputs, same outputs).
 #pragma once
@@ -74,6 +92,16 @@ struct LineData {
   std::span<const ra::OdometrySection> odometry_sections;    // as ra::OdometryConfig::sections
 };
 
+// The radio area of one wayside unit on the train's line (see the header comment).
+struct RadioArea {
+  std::uint16_t peer_id = 0;                 // the unit's radio id (the link's peer)
+  std::int64_t origin_mm = 0;                // its chainage 0; a virtual-block boundary
+  std::optional<std::int64_t> boundary_mm;   // its system boundary; every area but the last
+};
+
+// Links held at once: the unit the train is in and the next one.
+inline constexpr std::size_t kRadioLinks = 2;
+
 struct OnboardConfig {
   std::uint32_t train_id = 0;                  // in every application message
   br::TrainData train{};                       // length and accel_max feed odometry and crossings
@@ -86,7 +114,10 @@ struct OnboardConfig {
   // Crossing parameters; train_id, train_length_mm and accel_max_mm_s2 are the unit's.
   lc::onboard::ProtectionConfig crossing{};
   mb::onboard::AuthorityConfig authority = mb::onboard::DefaultAuthorityConfig();
-  tg::EndpointConfig radio{};                  // role kTrain
+  tg::EndpointConfig radio{};                  // role kTrain; peer_id of each area's link
+  // the wayside units along the line, origins increasing; none: one unit (radio.peer_id)
+  // whose chainage is the line's
+  std::span<const RadioArea> radio_areas;
   std::optional<tg::LinkKey> link_key;
   std::int64_t radio_period_ms = params::tg::train_cycle_ms;
   std::int64_t radio_offset_ms = 0;            // first telegram this long after the first cycle
@@ -105,12 +136,27 @@ enum class OnboardConfigError : std::uint8_t {
   kCrossings,        // CrossingProtection::Create or LoadCrossings refused (`crossings`)
   kRadio,            // role not kTrain, no link key, or Endpoint::Init refused (`radio`)
   kOutOfMemory,
+  kRadioAreas,       // radio_areas refused (`areas`, `entry`)
 };
 
 constexpr const char* ToString(OnboardConfigError e) noexcept {
-  return core::EnumName(e, std::array<const char*, 10>{"NONE", "PERIODS", "BLOCKS", "BALISES", "ODOMETRY",
+  return core::EnumName(e, std::array<const char*, 11>{"NONE", "PERIODS", "BLOCKS", "BALISES", "ODOMETRY",
                                                        "TRAIN_DATA", "LINE_PROFILE", "CROSSINGS", "RADIO",
-                                                       "OUT_OF_MEMORY"});
+                                                       "OUT_OF_MEMORY", "RADIO_AREAS"});
+}
+
+enum class RadioAreaError : std::uint8_t {
+  kNone,
+  kNotIncreasing,        // an origin not above the previous area's
+  kOriginNotOnBlock,     // an origin that is no virtual-block boundary of the line
+  kBoundaryOutsideArea,  // a boundary missing (not the last area), on the last area, or not
+                         // after the next area's origin and on the line
+  kPeerTwice,            // a peer id twice, or the train's own radio id
+};
+
+constexpr const char* ToString(RadioAreaError e) noexcept {
+  return core::EnumName(e, std::array<const char*, 5>{"NONE", "NOT_INCREASING", "ORIGIN_NOT_ON_BLOCK",
+                                                      "BOUNDARY_OUTSIDE_AREA", "PEER_TWICE"});
 }
 
 // The first error of a configuration and the module's own reason.
@@ -122,6 +168,7 @@ struct ConfigCheck {
   br::ProfileResult profile{};
   lc::onboard::ProtectionError crossings = lc::onboard::ProtectionError::kNone;
   tg::ConfigError radio = tg::ConfigError::kNone;
+  RadioAreaError areas = RadioAreaError::kNone;
 };
 
 // ---- one cycle's inputs and outputs ------------------------------------------------------
@@ -131,6 +178,9 @@ struct OnboardInputs {
   ra::CycleInput sensors{};                           // time_ms and balise are the unit's
   std::optional<std::uint32_t> balise_id;             // a balise read this cycle
   std::span<const std::span<const std::uint8_t>> frames;  // received frames, in order
+  // frames of the next unit (the link of OnboardOutputs::handover_area); their events count
+  // on after `frames`
+  std::span<const std::span<const std::uint8_t>> handover_frames;
   br::DriverInputs driver{};                          // standstill is the odometry's
   std::optional<std::int64_t> dwell_departure_ms;     // standing at a scheduled stop (REQ-LC-005)
 };
@@ -209,7 +259,7 @@ struct RxEvent {
 
 struct OnboardOutputs {
   std::int64_t now_ms = 0;
-  BrakeDemand brake = BrakeDemand::kEmergency;
+  BrakeDemand brake = BrakeDemand::kEmergency;  // RADIO_LINK: a link that counts is not up
   BrakeReason reason = BrakeReason::kRadioLink;
   br::BrakeLevel level = br::BrakeLevel::kNone;   // the supervisor's last decision
   Indications indications{};
@@ -224,7 +274,7 @@ struct OnboardOutputs {
   // the movement authority
   bool authority_usable = false;
   std::optional<std::int64_t> authority_limit_mm;
-  // the radio
+  // the radio (`link`: kUp when every link that counts is up, else the first that is not)
   tg::LinkState link = tg::LinkState::kNone;
   bool sent = false;                             // `frame` holds this cycle's telegram
   tg::LinkState send_link = tg::LinkState::kNone;  // the link supervision at the last telegram
@@ -232,7 +282,13 @@ struct OnboardOutputs {
   tg::SendStatus send_status = tg::SendStatus::kSent;
   messages::EncodeError encode_error = messages::EncodeError::kNone;  // the bundle (report sent alone)
   std::size_t crossing_messages_sent = 0;
-  std::array<RxEvent, kMaxRxEvents> events{};
+  // the handover: the area of the first link (0 without radio areas) and of the second
+  std::size_t radio_area = 0;
+  std::optional<std::size_t> handover_area;
+  tg::LinkState handover_link = tg::LinkState::kNone;
+  bool handover_sent = false;                    // `handover_frame` holds a telegram to it
+  tg::EncodedFrame handover_frame{};
+  std::array<RxEvent, 2 * kMaxRxEvents> events{};
   std::size_t event_count = 0;
   // the modules' verdicts of this cycle
   lc::onboard::ProtectionError crossing_error = lc::onboard::ProtectionError::kNone;
@@ -266,11 +322,40 @@ class OnboardUnit {
   [[nodiscard]] const lc::onboard::CrossingProtection& Crossings() const noexcept { return *crossings_; }
 
  private:
+  // One wayside unit's link: its area, endpoint, authority and the restrictions it sent last
+  // (line chainage).
+  struct RadioLink {
+    std::optional<std::size_t> area;  // engaged while open
+    tg::Endpoint endpoint;
+    mb::onboard::AuthorityReceiver authority{mb::onboard::DefaultAuthorityConfig()};
+    messages::Obstruction obstruction = messages::Obstruction::kNone;
+    std::array<messages::SpeedRestriction, messages::kTelegramRestrictionsMax> restrictions{};
+    std::size_t restriction_count = 0;
+  };
+
   [[nodiscard]] ConfigCheck Init(const OnboardConfig& config) noexcept;
+  [[nodiscard]] ConfigCheck InitAreas(const OnboardConfig& config) noexcept;
+  [[nodiscard]] tg::ConfigError Open(RadioLink& link, std::size_t area) noexcept;
+  void Close(RadioLink& link) noexcept;
+  [[nodiscard]] RadioLink& First() noexcept { return links_[first_]; }
+  [[nodiscard]] RadioLink& Second() noexcept { return links_[1 - first_]; }
+  [[nodiscard]] std::int64_t ToArea(const RadioLink& link, std::int64_t line_mm) const noexcept;
+  [[nodiscard]] std::int64_t FromArea(const RadioLink& link, std::int64_t area_mm) const noexcept;
+  [[nodiscard]] std::optional<std::int64_t> BoundaryOf(const RadioLink& link) const noexcept;
+  [[nodiscard]] bool Released(const ra::OdometryOutput& o) const noexcept;
+  void Authority(const ra::OdometryOutput& o) noexcept;
+  [[nodiscard]] tg::LinkState LinkDemand(const ra::OdometryOutput& o) const noexcept;
+  void ManageLinks(const ra::OdometryOutput& o) noexcept;
   void Send(const ra::OdometryOutput& o) noexcept;
-  [[nodiscard]] messages::Message Report(const ra::OdometryOutput& o) const noexcept;
-  void Receive(const OnboardInputs& in) noexcept;
-  void OnMessage(const messages::Message& m, RxEvent event) noexcept;
+  [[nodiscard]] std::size_t SendOn(RadioLink& link, const ra::OdometryOutput& o, tg::EncodedFrame& frame,
+                                   tg::Endpoint::CycleOutput& sent) noexcept;
+  [[nodiscard]] messages::Message Report(const ra::OdometryOutput& o, const RadioLink& link) const noexcept;
+  void Receive(const OnboardInputs& in, std::size_t frames_area,
+               std::optional<std::size_t> handover_frames_area) noexcept;
+  void ReceiveOn(RadioLink& link, std::span<const std::span<const std::uint8_t>> frames, std::size_t first_index,
+                 std::int64_t now_ms) noexcept;
+  void OnMessage(RadioLink& link, const messages::Message& m, RxEvent event) noexcept;
+  void UpdateRestrictions() noexcept;
   void AddEvent(const RxEvent& e) noexcept;
   void UpdateProfile() noexcept;
   void Protect(const OnboardInputs& in, const ra::OdometryOutput& o) noexcept;
@@ -301,11 +386,19 @@ class OnboardUnit {
   ra::Odometry odometry_;
   std::optional<br::PatternCalculator> patterns_;
   br::Supervisor supervisor_;
-  mb::onboard::AuthorityReceiver authority_{mb::onboard::DefaultAuthorityConfig()};
+  mb::onboard::AuthorityConfig authority_config_ = mb::onboard::DefaultAuthorityConfig();
   mb::onboard::SpeedRestrictionStore restrictions_;
-  messages::Obstruction obstruction_ = messages::Obstruction::kNone;
   std::optional<lc::onboard::CrossingProtection> crossings_;
-  tg::Endpoint endpoint_;
+  // the radio: the areas (one without radio_areas), the block index of each origin, the links
+  tg::EndpointConfig radio_{};
+  std::optional<tg::LinkKey> link_key_;
+  core::FixedVector<RadioArea> areas_;
+  core::FixedVector<std::uint32_t> origin_blocks_;
+  std::array<RadioLink, kRadioLinks> links_{};
+  std::size_t first_ = 0;
+  // this cycle's usable movement authority of the links that count, and its obstruction
+  std::optional<std::int64_t> authority_mm_;
+  messages::Obstruction obstruction_ = messages::Obstruction::kNone;
   // this cycle's crossing messages received, the rotation of the pending ones to send
   std::array<messages::CrossingReport, lc::onboard::kMaxMessagesPerCycle> reports_{};
   std::size_t report_count_ = 0;
