@@ -5,7 +5,8 @@
 //      answers taken, the boundary accepted or not
 //   3. the moving-block ground cycle
 //   4. the centre schedulers (with the controllers' acknowledgements and reports of the last
-//      cycle), then the crossing controllers (with this cycle's start times and stops, the
+//      cycle, or those received over an external link), then the crossing controllers (with
+//      this cycle's start times and stops, or those received over an external link, the
 //      requests and withdrawals received since the last cycle and the equipment state)
 //   5. trains handed over and past the boundary released, requests for those in the overlap
 //   6. one telegram per train: its stop limit (or a keep-alive), then the crossing messages
@@ -18,6 +19,23 @@
 #include "wayside_internal.hpp"
 
 namespace railproof::units {
+namespace {
+
+// The part of a received centre-link list that is used (Cycle reports a longer one).
+template <typename T>
+std::span<const T> Bounded(std::span<const T> list) noexcept {
+  return list.first(std::min(list.size(), kMaxLinkMessages));
+}
+
+// Appends as many of `from` as fit (the centre's inbox holds what it takes in one cycle).
+template <typename T>
+void Append(core::FixedVector<T>& to, const core::FixedVector<T>& from) noexcept {
+  for (const T& x : from) {
+    (void)to.PushBack(x);
+  }
+}
+
+}  // namespace
 
 void WaysideUnit::Event(InputStatus status, std::uint32_t id, HandoverVerdict verdict) noexcept {
   (void)out_.events.PushBack(InputEvent{status, id, verdict});
@@ -30,6 +48,11 @@ const CycleOutput& WaysideUnit::Cycle(std::int64_t now_ms, const CycleInput& inp
   out_.handover_requests.Clear();
   out_.handover_responses.Clear();
   out_.released.Clear();
+  out_.start_times.Clear();
+  out_.warning_stops.Clear();
+  out_.start_acks.Clear();
+  out_.stop_acks.Clear();
+  out_.crossing_reports.Clear();
   out_.events.Clear();
   if (now_ms < last_cycle_ms_) {
     // nothing done, nothing sent (safe side); the crossing equipment keeps its last commands
@@ -43,7 +66,21 @@ const CycleOutput& WaysideUnit::Cycle(std::int64_t now_ms, const CycleInput& inp
   TakeAnswers(input.from_next);
   BoundaryAcceptance();
   (void)ground_->Cycle(now_ms);
+  const ToCrossings& tx = input.to_crossings;
+  const ToCentre& rx = input.to_centre;
+  const std::size_t longest = std::max({tx.start_times.size(), tx.warning_stops.size(), rx.start_acks.size(),
+                                        rx.stop_acks.size(), rx.reports.size()});
+  if (link_ == CentreLink::kInternal && longest > 0) {
+    Event(InputStatus::kLinkNotExternal, 0);
+  } else if (longest > kMaxLinkMessages) {
+    Event(InputStatus::kTooManyMessages, 0);
+  }
+  if (link_ == CentreLink::kExternal) {
+    ReceiveAtCentre(rx);
+  }
   CentreStep(now_ms);
+  DeliverToCrossings(link_ == CentreLink::kExternal ? ToCrossings{Bounded(tx.start_times), Bounded(tx.warning_stops)}
+                                                    : out_.ToCrossingsSent());
   CrossingStep(now_ms, input.crossings);
   ReleaseAndRequest();
   SendStep(now_ms);
@@ -153,15 +190,44 @@ void WaysideUnit::BoundaryAcceptance() noexcept {
                                   foremost->next_limit_mm.has_value());
 }
 
+// The centre link's messages to the centre (kExternal): those naming a crossing the unit does
+// not hold, or acknowledging a departure none of its schedulers holds, are not used.
+void WaysideUnit::ReceiveAtCentre(const ToCentre& in) noexcept {
+  const auto known = [this](std::uint32_t crossing_id, std::uint32_t departure_id) {
+    if (FindCrossing(crossing_id) == nullptr) {
+      Event(InputStatus::kUnknownCrossing, crossing_id);
+      return false;
+    }
+    if (!HoldsDeparture(departure_id)) {
+      Event(InputStatus::kUnknownDeparture, departure_id);
+      return false;
+    }
+    return true;
+  };
+  for (const lc::wayside::StartTimeAck& a : Bounded(in.start_acks)) {
+    if (known(a.crossing_id, a.departure_id)) {
+      (void)start_acks_.PushBack(a);
+    }
+  }
+  for (const lc::wayside::WarningStopAck& a : Bounded(in.stop_acks)) {
+    if (known(a.crossing_id, a.departure_id)) {
+      (void)stop_acks_.PushBack(a);
+    }
+  }
+  for (const messages::CrossingReport& r : Bounded(in.reports)) {
+    if (FindCrossing(r.crossing_id) == nullptr) {
+      Event(InputStatus::kUnknownCrossing, r.crossing_id);
+    } else {
+      (void)last_reports_.PushBack(r);
+    }
+  }
+}
+
 // The centre schedulers of the GNSS-time variant (lc design §5): the acknowledgements and
-// reports of the controllers' last cycle, the train's centre position report; their start
-// times and stops go to the controllers in this cycle.
+// reports received, the train's centre position report; their start times and stops are sent
+// in this cycle.
 // Connects the centre schedulers (REQ-LC-008, REQ-LC-010, implemented in lc) to the controllers.
 void WaysideUnit::CentreStep(std::int64_t now_ms) noexcept {
-  for (CrossingSlot& c : crossings_) {
-    c.start_time_count = 0;
-    c.stop_count = 0;
-  }
   for (DepartureSlot& d : departures_) {
     const auto& dep = d.scheduler->CurrentDeparture();
     if (!dep) {
@@ -169,8 +235,8 @@ void WaysideUnit::CentreStep(std::int64_t now_ms) noexcept {
     }
     lc::wayside::SchedulerInput in;
     in.now_ms = now_ms;
-    in.start_acks = std::span<const lc::wayside::StartTimeAck>(start_acks_.data(), start_ack_count_);
-    in.stop_acks = std::span<const lc::wayside::WarningStopAck>(stop_acks_.data(), stop_ack_count_);
+    in.start_acks = start_acks_.Span();
+    in.stop_acks = stop_acks_.Span();
     in.reports = last_reports_.Span();
     in.position = d.position;
     in.restrictions = profile_.Span();
@@ -180,21 +246,40 @@ void WaysideUnit::CentreStep(std::int64_t now_ms) noexcept {
     }
     const lc::wayside::SchedulerOutput& o = d.scheduler->Output();
     for (const lc::wayside::StartTimeMessage& m : o.StartTimes()) {
-      CrossingSlot* c = FindCrossing(m.crossing_id);
-      if (c != nullptr && c->start_time_count < c->start_times.size()) {
-        c->start_times[c->start_time_count++] = m;
-      }
+      (void)out_.start_times.PushBack(m);
     }
     for (const lc::wayside::WarningStopMessage& m : o.WarningStops()) {
-      CrossingSlot* c = FindCrossing(m.crossing_id);
-      if (c != nullptr && c->stop_count < c->stops.size()) {
-        c->stops[c->stop_count++] = m;
-      }
+      (void)out_.warning_stops.PushBack(m);
     }
     (void)out_.departures.PushBack(DepartureOutput{dep->train_id, dep->departure_id, o.departure_cleared, o.block});
   }
-  start_ack_count_ = 0;
-  stop_ack_count_ = 0;
+  start_acks_.Clear();
+  stop_acks_.Clear();
+  last_reports_.Clear();
+}
+
+// The start times and stops for the controllers of this cycle: the centre's of this cycle
+// (kInternal) or those received (kExternal); a message for a crossing the unit does not hold,
+// or beyond what its controller takes in one cycle, is not used.
+void WaysideUnit::DeliverToCrossings(const ToCrossings& in) noexcept {
+  for (CrossingSlot& c : crossings_) {
+    c.start_time_count = 0;
+    c.stop_count = 0;
+  }
+  const auto deliver = [this](const auto& messages, auto list, auto count) {
+    for (const auto& m : messages) {
+      CrossingSlot* c = FindCrossing(m.crossing_id);
+      if (c == nullptr) {
+        Event(InputStatus::kUnknownCrossing, m.crossing_id);
+      } else if (c->*count >= (c->*list).size()) {
+        Event(InputStatus::kTooManyMessages, m.crossing_id);
+      } else {
+        (c->*list)[(c->*count)++] = m;
+      }
+    }
+  };
+  deliver(in.start_times, &CrossingSlot::start_times, &CrossingSlot::start_time_count);
+  deliver(in.warning_stops, &CrossingSlot::stops, &CrossingSlot::stop_count);
 }
 
 // Keeps a crossing message for the train's next telegrams: a newer report of a crossing
@@ -221,7 +306,7 @@ void WaysideUnit::Enqueue(Slot& s, const messages::Message& m) noexcept {
 }
 
 // Connects the crossing controllers (REQ-LC-003, REQ-LC-006, REQ-LC-007, implemented in lc) to
-// the trains' telegrams and the crossing equipment.
+// the trains' telegrams, the crossing equipment and the centre link.
 void WaysideUnit::CrossingStep(std::int64_t now_ms, std::span<const CrossingSensors> sensors) noexcept {
   for (const CrossingSensors& x : sensors) {
     if (FindCrossing(x.crossing_id) == nullptr) {
@@ -229,7 +314,6 @@ void WaysideUnit::CrossingStep(std::int64_t now_ms, std::span<const CrossingSens
     }
   }
   out_.crossings.Clear();
-  last_reports_.Clear();
   for (CrossingSlot& c : crossings_) {
     lc::wayside::ControllerInput in;
     in.now_ms = now_ms;
@@ -253,7 +337,7 @@ void WaysideUnit::CrossingStep(std::int64_t now_ms, std::span<const CrossingSens
     c.withdrawal_count = 0;
     const lc::wayside::ControllerOutput& o = c.controller->Output();
     (void)out_.crossings.PushBack(CrossingOutput{c.data.id, o.lights_on, o.barriers_down_commanded, o.alarm, o.report});
-    (void)last_reports_.PushBack(o.report);
+    (void)out_.crossing_reports.PushBack(o.report);
     // the report goes to every train among its requesters (lc design §3 item 3), the
     // acknowledgement to the train that withdrew
     for (std::size_t i = 0; i < o.report.requester_count && i < o.report.requesters.size(); ++i) {
@@ -266,16 +350,21 @@ void WaysideUnit::CrossingStep(std::int64_t now_ms, std::span<const CrossingSens
         Enqueue(*s, messages::WithdrawalAck{c.data.id, t});
       }
     }
-    for (const lc::wayside::StartTimeAck& a : o.StartAcks()) {
-      if (start_ack_count_ < start_acks_.size()) {
-        start_acks_[start_ack_count_++] = a;
+    for (lc::wayside::StartTimeAck a : o.StartAcks()) {
+      if (RAILPROOF_FAULT(FAULT_UNIT_START_ACK_WRONG_CROSSING)) {
+        a.crossing_id = crossings_[(static_cast<std::size_t>(&c - crossings_.begin()) + 1) % crossings_.Size()].data.id;
       }
+      (void)out_.start_acks.PushBack(a);
     }
     for (const lc::wayside::WarningStopAck& a : o.StopAcks()) {
-      if (stop_ack_count_ < stop_acks_.size()) {
-        stop_acks_[stop_ack_count_++] = a;
-      }
+      (void)out_.stop_acks.PushBack(a);
     }
+  }
+  if (link_ == CentreLink::kInternal) {
+    // the centre takes them in its next step
+    Append(start_acks_, out_.start_acks);
+    Append(stop_acks_, out_.stop_acks);
+    Append(last_reports_, out_.crossing_reports);
   }
 }
 

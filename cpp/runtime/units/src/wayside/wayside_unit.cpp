@@ -2,6 +2,7 @@
 // received from them (include/railproof/units/wayside_unit.hpp; the cycle: wayside_cycle.cpp).
 #include "railproof/units/wayside_unit.hpp"
 
+#include <algorithm>
 #include <new>
 #include <variant>
 
@@ -59,6 +60,9 @@ ConfigError WaysideUnit::Init(const WaysideConfig& config, CreateResult& result)
   if (config.secure_ahead_mm && (*config.secure_ahead_mm < 0 || *config.secure_ahead_mm > mb::wayside::kMaxLineMm)) {
     return ConfigError::kSecureAheadInvalid;
   }
+  if (config.centre_link != CentreLink::kInternal && config.centre_link != CentreLink::kExternal) {
+    return ConfigError::kCentreLinkInvalid;
+  }
   if (config.crossings.size() > lc::kMaxCrossings) {
     return ConfigError::kTooManyCrossings;
   }
@@ -72,7 +76,13 @@ ConfigError WaysideUnit::Init(const WaysideConfig& config, CreateResult& result)
   }
   const std::size_t trains = capacity.trains;
   outbox_per_slot_ = 2 * config.crossings.size();  // one report and one acknowledgement per crossing
-  const std::size_t events = 2 * trains + config.crossings.size() + 2 * kMaxNeighbourMessages + config.departures;
+  // each departure sends at most one start time and one stop per crossing and cycle
+  const std::size_t centre_sent = config.departures * config.crossings.size();
+  // the centre link: one event per message not used (five lists), per list too long, and
+  // per start time or stop beyond a controller's input
+  const std::size_t link_events = 5 * kMaxLinkMessages + 6 + 2 * centre_sent;
+  const std::size_t events =
+      2 * trains + config.crossings.size() + 2 * kMaxNeighbourMessages + config.departures + link_events;
   if (!slots_.Allocate(trains) || !slots_.Resize(trains) || !handover_mm_.Allocate(cells) ||
       !handover_ids_.Allocate(cells) || !cell_load_.Allocate(cells) || !cell_load_.Resize(cells) ||
       !blocks_mm_.AssignFrom(config.line.blocks_mm, config.line.blocks_mm.size()) ||
@@ -80,7 +90,11 @@ ConfigError WaysideUnit::Init(const WaysideConfig& config, CreateResult& result)
       !outbox_.Resize(trains * outbox_per_slot_) || !crossings_.Allocate(config.crossings.size()) ||
       !departures_.Allocate(config.departures) || !departures_.Resize(config.departures) ||
       !departure_crossings_.Allocate(config.crossings.size()) || !profile_.AssignFrom(config.profile, config.profile.size()) ||
-      !last_reports_.Allocate(config.crossings.size()) || !out_.frames.Allocate(trains) ||
+      !start_acks_.Allocate(kMaxLinkMessages) || !stop_acks_.Allocate(kMaxLinkMessages) ||
+      !last_reports_.Allocate(std::max(kMaxLinkMessages, config.crossings.size())) ||
+      !out_.start_times.Allocate(centre_sent) || !out_.warning_stops.Allocate(centre_sent) ||
+      !out_.start_acks.Allocate(kMaxLinkMessages) || !out_.stop_acks.Allocate(kMaxLinkMessages) ||
+      !out_.crossing_reports.Allocate(config.crossings.size()) || !out_.frames.Allocate(trains) ||
       !out_.trains.Allocate(trains) || !out_.crossings.Allocate(config.crossings.size()) ||
       !out_.departures.Allocate(config.departures) || !out_.handover_requests.Allocate(trains) ||
       !out_.handover_responses.Allocate(kMaxNeighbourMessages) || !out_.released.Allocate(trains) ||
@@ -119,6 +133,7 @@ ConfigError WaysideUnit::Init(const WaysideConfig& config, CreateResult& result)
   boundary_mm_ = config.line.system_boundary_mm;
   margin_boundary_mm_ = config.line.margins.system_boundary_mm;
   last_cycle_ms_ = config.start_ms;
+  link_ = config.centre_link;
   return ConfigError::kNone;
 }
 
@@ -163,6 +178,16 @@ const lc::wayside::CentreScheduler* WaysideUnit::Scheduler(std::uint32_t train_i
     }
   }
   return nullptr;
+}
+
+bool WaysideUnit::HoldsDeparture(std::uint32_t departure_id) const noexcept {
+  for (const DepartureSlot& d : departures_) {
+    const auto& dep = d.scheduler->CurrentDeparture();
+    if (dep && dep->departure_id == departure_id) {
+      return true;
+    }
+  }
+  return false;
 }
 
 // Base station (cell) i covers [handover i-1, handover i).

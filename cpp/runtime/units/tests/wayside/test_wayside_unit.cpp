@@ -1,6 +1,6 @@
 // The wayside unit through its interface: configuration, admission and registration by base
-// station, telegram bytes in and out, typed rejections, crossings, the centre, no heap after
-// Create.
+// station, telegram bytes in and out, typed rejections, crossings, the centre and its link to
+// the crossings, no heap after Create.
 #include <gtest/gtest.h>
 
 #include <array>
@@ -26,8 +26,10 @@ struct Fixture {
   std::int64_t now = 0;
   CycleInput input{};
 
-  explicit Fixture(std::size_t per_station = kTrainsPerBaseStation, std::size_t departures = 0) {
+  explicit Fixture(std::size_t per_station = kTrainsPerBaseStation, std::size_t departures = 0,
+                   CentreLink link = CentreLink::kInternal) {
     config = BaseConfig(line);
+    config.centre_link = link;
     config.trains_per_base_station = per_station;
     config.crossings = crossings;
     config.departures = departures;
@@ -78,6 +80,9 @@ TEST(WaysideUnitConfig, RefusesEachInvalidPartWithItsReason) {
   c.departures = 1;
   c.scheduler.accel_max_mm_s2 = 0;
   EXPECT_EQ(WaysideUnit::Create(c).error, ConfigError::kSchedulerInvalid);
+  c = BaseConfig(line);
+  c.centre_link = static_cast<CentreLink>(2);
+  EXPECT_EQ(WaysideUnit::Create(c).error, ConfigError::kCentreLinkInvalid);
 }
 
 TEST(WaysideUnitTrains, CapacityIsTheBaseStationsCapacity) {
@@ -294,6 +299,71 @@ TEST(WaysideUnitCentre, CentrePositionReportReachesTheDepartureScheduler) {
   f.now += kGroundCycleMs;
   (void)f.Cycle();
   EXPECT_TRUE(f.unit->Scheduler(3)->Crossings()[0].acked);
+}
+
+// With an external link the centre's start time leaves the unit instead of reaching the
+// controller; what comes back over the link is checked: a crossing the unit does not hold, an
+// acknowledgement of a departure it does not hold, and lists longer than a cycle takes are
+// refused with typed events, the rest is used, and nothing is allocated.
+TEST(WaysideUnitCentre, ExternalLinkCarriesTheMessagesAndRefusesUnknownNames) {
+  Fixture f(kTrainsPerBaseStation, 1, CentreLink::kExternal);
+  const std::array<std::uint32_t, 1> ids{7};
+  ASSERT_EQ(f.unit->StartDeparture({3, 1, 60'000, 1'000'000}, ids, f.now), lc::wayside::SchedulerError::kNone);
+  const auto& sent = f.Cycle();
+  ASSERT_EQ(sent.start_times.Size(), 1U);
+  EXPECT_EQ(sent.start_times[0].crossing_id, 7U);
+  EXPECT_FALSE(f.unit->Controller(7)->Status().pending.present);
+  EXPECT_EQ(sent.start_acks.Size(), 0U);
+  ASSERT_EQ(sent.crossing_reports.Size(), 1U);
+
+  const std::array<lc::wayside::StartTimeMessage, 2> starts{sent.start_times[0], {99, 1, 0}};
+  const std::array<lc::wayside::WarningStopMessage, 1> stops{{{98, 1}}};
+  f.input.to_crossings = ToCrossings{starts, stops};
+  f.now += kGroundCycleMs;
+  testing::StartCountingAllocations();
+  const auto& delivered = f.Cycle();
+  EXPECT_EQ(testing::StopCountingAllocations(), 0U);
+  EXPECT_TRUE(f.unit->Controller(7)->Status().pending.present);
+  ASSERT_EQ(delivered.start_acks.Size(), 1U);
+  ASSERT_EQ(delivered.events.Size(), 2U);
+  EXPECT_EQ(delivered.events[0].status, InputStatus::kUnknownCrossing);
+  EXPECT_EQ(delivered.events[0].id, 99U);
+  EXPECT_EQ(delivered.events[1].id, 98U);
+
+  const std::array<lc::wayside::StartTimeAck, 3> acks{
+      delivered.start_acks[0], lc::wayside::StartTimeAck{7, 42, 0, true}, lc::wayside::StartTimeAck{97, 1, 0, true}};
+  std::array<messages::CrossingReport, 1> reports{};
+  reports[0].crossing_id = 96;
+  f.input = CycleInput{};
+  f.input.to_centre = ToCentre{acks, {}, reports};
+  f.now += kGroundCycleMs;
+  const auto& answered = f.Cycle();
+  EXPECT_TRUE(f.unit->Scheduler(3)->Crossings()[0].acked);
+  ASSERT_EQ(answered.events.Size(), 3U);
+  EXPECT_EQ(answered.events[0].status, InputStatus::kUnknownDeparture);
+  EXPECT_EQ(answered.events[0].id, 42U);
+  EXPECT_EQ(answered.events[1].status, InputStatus::kUnknownCrossing);
+  EXPECT_EQ(answered.events[1].id, 97U);
+  EXPECT_EQ(answered.events[2].id, 96U);
+
+  const std::vector<messages::CrossingReport> flood(kMaxLinkMessages + 1, answered.crossing_reports[0]);
+  f.input = CycleInput{};
+  f.input.to_centre.reports = flood;
+  f.now += kGroundCycleMs;
+  const auto& flooded = f.Cycle();
+  ASSERT_EQ(flooded.events.Size(), 1U);
+  EXPECT_EQ(flooded.events[0].status, InputStatus::kTooManyMessages);
+}
+
+// A unit that connects the centre to its controllers itself uses no link input.
+TEST(WaysideUnitCentre, InternalLinkRefusesLinkInput) {
+  Fixture f(kTrainsPerBaseStation, 1);
+  const std::array<lc::wayside::StartTimeMessage, 1> starts{{{7, 1, 0}}};
+  f.input.to_crossings.start_times = starts;
+  const auto& out = f.Cycle();
+  ASSERT_EQ(out.events.Size(), 1U);
+  EXPECT_EQ(out.events[0].status, InputStatus::kLinkNotExternal);
+  EXPECT_FALSE(f.unit->Controller(7)->Status().pending.present);
 }
 
 TEST(WaysideUnitRadio, NoHeapAfterCreate) {

@@ -9,6 +9,7 @@
 //   crossings one lc::wayside::CrossingController per crossing of the line, and the centre
 //             schedulers of the GNSS-time pre-armed departures (lc::wayside::CentreScheduler)
 //   boundary  handover of a train to the neighbouring unit at the system boundary (below)
+//   centre    the link between the centre schedulers and the crossing controllers (below)
 // Train and ground meet only in railproof_messages (the payload codec) and the telegram layer.
 //
 // Usage (the line simulator, or a ground computer's main loop):
@@ -21,7 +22,8 @@
 //   every ground cycle (params::tg::ground_cycle_ms):
 //     const CycleOutput& out = unit.Cycle(now, inputs);  // crossing sensors, neighbour messages
 //     send out.frames[i].frame to train out.frames[i].train_id; drive out.crossings; hand
-//     out.handover_requests / out.handover_responses to the neighbouring units.
+//     out.handover_requests / out.handover_responses to the neighbouring units; with an
+//     external centre link, carry out.ToCrossingsSent() / out.ToCentreSent() (below).
 //
 // Handover at the system boundary (D5 §5.1.4 obstruction 5; mb's system boundary, REQ-MB-023).
 // The releasing unit's line ends past its system boundary (the overlap with the next unit,
@@ -38,6 +40,22 @@
 //      accepting unit's stop limit governs past the boundary. A refused train stops at the
 //      boundary minus its margin.
 //   4. The releasing unit removes the train once its extended rear has passed the boundary.
+//
+// The centre link (GNSS-time variant, lc design §5, D4 §4.8.2). The centre schedulers send
+// start times and warning stops to the crossing controllers; the controllers answer with
+// acknowledgements and their reports. Each cycle runs the schedulers before the controllers,
+// and CycleOutput lists what each side sent in it.
+//   kInternal  the centre and the crossings in one place: the unit delivers the start times and
+//              stops to the controllers in the same cycle, the acknowledgements and reports to
+//              the schedulers in the next one (the link input is refused, kLinkNotExternal).
+//   kExternal  the crossings elsewhere, behind a ground network that may lose, delay or repeat
+//              messages (lc design §5 tolerates each): the integrator carries them, from
+//              out.ToCrossingsSent() of the unit holding the departures to
+//              CycleInput::to_crossings of the unit holding the crossings, and from
+//              out.ToCentreSent() back to
+//              CycleInput::to_centre; one unit may hold both ends. A received message naming a
+//              crossing the unit does not hold, or an acknowledgement naming a departure none of
+//              its schedulers holds, is not used (kUnknownCrossing, kUnknownDeparture).
 //
 // Runtime module: no heap after Create, no exceptions, no recursion, bounded loops, typed
 // results, deterministic. Units: mm, mm/s, ms (int64); the telegram layer's clock is now_ms
@@ -71,6 +89,15 @@ inline constexpr auto kTrainsPerBaseStation = static_cast<std::size_t>(params::t
 inline constexpr std::int64_t kGroundCycleMs = params::tg::ground_cycle_ms;
 // Most neighbour messages (requests or responses) per cycle and direction.
 inline constexpr std::size_t kMaxNeighbourMessages = 16;
+// Most messages per list of the centre link per cycle and direction (the schedulers' limit).
+inline constexpr std::size_t kMaxLinkMessages = lc::wayside::kMaxSchedulerMessages;
+
+// Who carries the messages between the centre schedulers and the crossing controllers (above).
+enum class CentreLink : std::uint8_t { kInternal, kExternal };
+
+constexpr const char* ToString(CentreLink l) noexcept {
+  return core::EnumName(l, std::array<const char*, 2>{"INTERNAL", "EXTERNAL"});
+}
 
 // The link key of a train (the key management of the line, outside the unit): true and `key`
 // filled, or false if the train has none.
@@ -99,6 +126,7 @@ struct WaysideConfig {
   std::size_t departures = 0;
   lc::wayside::SchedulerConfig scheduler{};
   std::span<const core::RestrictionSegment> profile;
+  CentreLink centre_link = CentreLink::kInternal;
   // global chainage of the line's 0, and where the next unit's area begins (local, < the
   // system boundary; requires one)
   std::int64_t origin_mm = 0;
@@ -118,10 +146,11 @@ enum class ConfigError : std::uint8_t {
   kSchedulerInvalid,      // departures > 0 and the scheduler parameters refused
   kHandoverZoneInvalid,   // without a system boundary, or not in [0, boundary)
   kOutOfMemory,
+  kCentreLinkInvalid,     // not a CentreLink
 };
 
 constexpr const char* ToString(ConfigError e) noexcept {
-  return core::EnumName(e, std::array<const char*, 11>{"NONE", "NO_KEY_PROVIDER", "RADIO_INVALID", "LINE_INVALID", "BASE_STATION_CAPACITY_INVALID", "SECURE_AHEAD_INVALID", "TOO_MANY_CROSSINGS", "CROSSING_INVALID", "SCHEDULER_INVALID", "HANDOVER_ZONE_INVALID", "OUT_OF_MEMORY"});
+  return core::EnumName(e, std::array<const char*, 12>{"NONE", "NO_KEY_PROVIDER", "RADIO_INVALID", "LINE_INVALID", "BASE_STATION_CAPACITY_INVALID", "SECURE_AHEAD_INVALID", "TOO_MANY_CROSSINGS", "CROSSING_INVALID", "SCHEDULER_INVALID", "HANDOVER_ZONE_INVALID", "OUT_OF_MEMORY", "CENTRE_LINK_INVALID"});
 }
 
 enum class AdmitStatus : std::uint8_t {
@@ -210,6 +239,20 @@ struct CrossingSensors {
   lc::wayside::ClockInput clock = lc::wayside::ClockInput::kGnss;
 };
 
+// Centre -> crossing controllers (the centre link): the departures' start times and stops.
+struct ToCrossings {
+  std::span<const lc::wayside::StartTimeMessage> start_times;
+  std::span<const lc::wayside::WarningStopMessage> warning_stops;
+};
+
+// Crossing controllers -> centre: the acknowledgements and the crossings' reports (the centre
+// takes a crossing's clock fault from its last report).
+struct ToCentre {
+  std::span<const lc::wayside::StartTimeAck> start_acks;
+  std::span<const lc::wayside::WarningStopAck> stop_acks;
+  std::span<const messages::CrossingReport> reports;
+};
+
 // Releasing unit -> accepting unit (global chainage).
 struct HandoverRequest {
   std::uint32_t train_id = 0;
@@ -243,6 +286,9 @@ struct CycleInput {
   std::span<const CrossingSensors> crossings;
   std::span<const HandoverRequest> from_previous;   // requests of the unit before this one
   std::span<const HandoverResponse> from_next;      // answers of the unit after this one
+  // CentreLink::kExternal: what the crossings and the centre received since the last cycle
+  ToCrossings to_crossings;
+  ToCentre to_centre;
 };
 
 // Why a cycle input was not used.
@@ -254,15 +300,17 @@ enum class InputStatus : std::uint8_t {
   kSchedulerRefused,       // a scheduler refused its cycle
   kBaseStationFull,        // a handover point ahead of the train cannot be secured (no room)
   kHandoverRefused,        // the next unit refused the train (verdict)
+  kUnknownDeparture,       // a centre-link acknowledgement of a departure no scheduler holds
+  kLinkNotExternal,        // centre-link messages given to a unit that connects them itself
 };
 
 constexpr const char* ToString(InputStatus s) noexcept {
-  return core::EnumName(s, std::array<const char*, 7>{"UNKNOWN_CROSSING", "UNKNOWN_TRAIN", "TOO_MANY_MESSAGES", "CONTROLLER_REFUSED", "SCHEDULER_REFUSED", "BASE_STATION_FULL", "HANDOVER_REFUSED"});
+  return core::EnumName(s, std::array<const char*, 9>{"UNKNOWN_CROSSING", "UNKNOWN_TRAIN", "TOO_MANY_MESSAGES", "CONTROLLER_REFUSED", "SCHEDULER_REFUSED", "BASE_STATION_FULL", "HANDOVER_REFUSED", "UNKNOWN_DEPARTURE", "LINK_NOT_EXTERNAL"});
 }
 
 struct InputEvent {
   InputStatus status = InputStatus::kUnknownCrossing;
-  std::uint32_t id = 0;  // the crossing or train
+  std::uint32_t id = 0;  // the crossing, train or departure
   HandoverVerdict verdict = HandoverVerdict::kAccepted;
 };
 
@@ -309,7 +357,19 @@ struct CycleOutput {
   core::FixedVector<HandoverRequest> handover_requests;    // to the next unit
   core::FixedVector<HandoverResponse> handover_responses;  // to the previous unit
   core::FixedVector<std::uint32_t> released;               // trains handed over and removed
+  // the centre link this cycle (kInternal: already delivered, listed for the record)
+  core::FixedVector<lc::wayside::StartTimeMessage> start_times;  // centre -> crossings
+  core::FixedVector<lc::wayside::WarningStopMessage> warning_stops;
+  core::FixedVector<lc::wayside::StartTimeAck> start_acks;       // crossings -> centre
+  core::FixedVector<lc::wayside::WarningStopAck> stop_acks;
+  core::FixedVector<messages::CrossingReport> crossing_reports;
   core::FixedVector<InputEvent> events;
+
+  // Views valid until the unit's next Cycle (copy them to hand them back to the same unit).
+  [[nodiscard]] ToCrossings ToCrossingsSent() const noexcept { return {start_times.Span(), warning_stops.Span()}; }
+  [[nodiscard]] ToCentre ToCentreSent() const noexcept {
+    return {start_acks.Span(), stop_acks.Span(), crossing_reports.Span()};
+  }
 };
 
 // ---- the unit ----------------------------------------------------------------------------------
@@ -436,7 +496,10 @@ class WaysideUnit {
   void AnswerPrevious(std::span<const HandoverRequest> requests) noexcept;
   void TakeAnswers(std::span<const HandoverResponse> answers) noexcept;
   void BoundaryAcceptance() noexcept;
+  [[nodiscard]] bool HoldsDeparture(std::uint32_t departure_id) const noexcept;
+  void ReceiveAtCentre(const ToCentre& in) noexcept;
   void CentreStep(std::int64_t now_ms) noexcept;
+  void DeliverToCrossings(const ToCrossings& in) noexcept;
   void CrossingStep(std::int64_t now_ms, std::span<const CrossingSensors> sensors) noexcept;
   void ReleaseAndRequest() noexcept;
   using StopLimitTelegramView = const messages::StopLimitTelegram*;
@@ -469,11 +532,12 @@ class WaysideUnit {
   core::FixedVector<lc::CrossingData> departure_crossings_;  // StartDeparture scratch
   core::FixedVector<std::int64_t> blocks_mm_;     // virtual block boundaries of the line (reports to fronts)
   core::FixedVector<core::RestrictionSegment> profile_;
-  core::FixedVector<messages::CrossingReport> last_reports_;  // the controllers' last reports
-  std::array<lc::wayside::StartTimeAck, lc::wayside::kMaxSchedulerMessages> start_acks_{};
-  std::size_t start_ack_count_ = 0;
-  std::array<lc::wayside::WarningStopAck, lc::wayside::kMaxSchedulerMessages> stop_acks_{};
-  std::size_t stop_ack_count_ = 0;
+  // what the centre takes in its next step: the controllers' last cycle (kInternal), or the
+  // link input accepted (kExternal)
+  CentreLink link_ = CentreLink::kInternal;
+  core::FixedVector<lc::wayside::StartTimeAck> start_acks_;
+  core::FixedVector<lc::wayside::WarningStopAck> stop_acks_;
+  core::FixedVector<messages::CrossingReport> last_reports_;
   CycleOutput out_;
 };
 
