@@ -58,18 +58,8 @@ void Replay(const rcli::JsonVector& v, std::vector<std::string>& problems) {
   for (std::size_t k = 0; k < v.steps.size() && problems.empty(); ++k) {
     const json& in = v.steps[k].at("in");
     const json& out = v.steps[k].at("out");
-    rb::PatternSpeeds p;
-    p.v_s = in.at("v_s").get<std::int64_t>();
-    p.v_e = in.at("v_e").get<std::int64_t>();
-    p.v_7n = in.at("v_7n").get<std::int64_t>();
-    p.v_6n = in.at("v_6n").get<std::int64_t>();
-    p.v_5n = in.at("v_5n").get<std::int64_t>();
-    p.v_4n = in.at("v_4n").get<std::int64_t>();
-    p.v_release = in.at("v_release").get<std::int64_t>();
-    rb::DriverInputs d;
-    d.standstill = in.at("standstill").get<bool>();
-    d.handle_emergency = in.at("handle_emergency").get<bool>();
-    d.reset = in.at("reset").get<bool>();
+    const rb::PatternSpeeds p = rcli::BrPatternSpeedsOf(in);
+    const rb::DriverInputs d = rcli::BrDriverInputsOf(in);
     const rb::Decision got = sup.Step(p, d);
     rcli::Checker chk(problems, "step " + std::to_string(k) + " (cycle " + std::to_string(k + 1) + "): ", &in);
     chk.Expect("level", out.at("level").get<std::string>(), rb::ToString(got.level));
