@@ -7,7 +7,10 @@
 //       telegram received (a stop limit with four restrictions and a crossing report: as many
 //       as one payload carries with it) and one
 //       sent (the position report). Supervision and radio are configured to run every cycle so
-//       that every timed cycle does all of it.
+//       that every timed cycle does all of it. Counters: the 99.9th percentile and the slowest
+//       single cycle (with the machine's interruptions in it), and worst_cycle_us, the
+//       scenario's slowest cycle with each cycle at its fastest over the identical runs (the
+//       unit's worst-case work as measured; a measurement, not a static timing analysis).
 //   BM_WaysideUnitCycle            one ground cycle of the wayside unit with 1,000 trains on the
 //       10,000 blocks of the moving-block benchmark line (bench_line.hpp): every train's position
 //       report received through its radio endpoint (Reed-Solomon decoding of a frame with bit
@@ -24,6 +27,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <random>
@@ -261,13 +265,28 @@ void BM_OnboardUnitCycleWorstCase(benchmark::State& state) {
   }
   std::uint64_t timed = 0, received = 0, sent = 0, supervised = 0;
   std::vector<double> times;
+  // per cycle of the scenario (its index from the start of compensation), the fastest of its
+  // runs: the scenario is deterministic, so every run does the same work in its i-th cycle,
+  // and an interruption of the process (another process, the hypervisor) only adds time
+  std::vector<double> fastest;
+  std::size_t runs = 0;
+  const auto collect = [&](const OnboardScenario& s) {
+    times.insert(times.end(), s.times_s_.begin(), s.times_s_.end());
+    if (s.Exhausted() || !s.TwoCandidates()) {  // a whole run (the last may be cut short)
+      ++runs;
+      fastest.resize(std::max(fastest.size(), s.times_s_.size()), std::numeric_limits<double>::infinity());
+      for (std::size_t i = 0; i < s.times_s_.size(); ++i) {
+        fastest[i] = std::min(fastest[i], s.times_s_[i]);
+      }
+    }
+  };
   for (auto _ : state) {
     if (sc->Exhausted() || !sc->TwoCandidates()) {
       state.PauseTiming();
       received += sc->received_;
       sent += sc->sent_;
       supervised += sc->supervised_;
-      times.insert(times.end(), sc->times_s_.begin(), sc->times_s_.end());
+      collect(*sc);
       sc = std::make_unique<OnboardScenario>();
       (void)sc->ToCompensation();
       state.ResumeTiming();
@@ -278,7 +297,7 @@ void BM_OnboardUnitCycleWorstCase(benchmark::State& state) {
   received += sc->received_;
   sent += sc->sent_;
   supervised += sc->supervised_;
-  times.insert(times.end(), sc->times_s_.begin(), sc->times_s_.end());
+  collect(*sc);
   // every timed cycle received a telegram, sent one and supervised a usable authority
   if (received != timed || sent != timed || supervised != timed) {
     state.SkipWithError("a timed cycle did not receive, send and supervise");
@@ -290,6 +309,13 @@ void BM_OnboardUnitCycleWorstCase(benchmark::State& state) {
   if (!times.empty()) {
     state.counters["p99.9_us"] = times[times.size() * 999 / 1000] * 1e6;
     state.counters["longest_us"] = times.back() * 1e6;
+  }
+  // The worst cycle of the scenario, each cycle taken at its fastest over the runs: the unit's
+  // own worst-case work, which the slowest single sample above cannot separate from the
+  // interruptions of a shared machine.
+  if (runs >= 3 && !fastest.empty()) {
+    state.counters["worst_cycle_us"] = *std::max_element(fastest.begin(), fastest.end()) * 1e6;
+    state.counters["runs"] = static_cast<double>(runs);
   }
   state.SetLabel("compensating (2 start points), 5 km look-ahead, 32 crossings, 1 telegram in + 1 out");
 }
