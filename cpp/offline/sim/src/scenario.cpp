@@ -34,6 +34,11 @@ const char* ToString(FaultType type) {
   return "invalid";
 }
 
+bool Scenario::OnWheelRail(std::uint16_t id) const {
+  return !low_adhesion.empty() &&
+         (!wheel_rail_trains || std::find(wheel_rail_trains->begin(), wheel_rail_trains->end(), id) != wheel_rail_trains->end());
+}
+
 namespace {
 
 // The ranges of the reader. Times: spec/schemas/scenario.schema.json ($defs/time, at most a
@@ -159,6 +164,41 @@ FaultSpec ReadFault(const JsonNode& n, const std::string& entry) {
     ton.Fail("window end not after its start (from_s)");
   }
   return f;
+}
+
+// low_adhesion.sections[]: sorted and disjoint, so that a point of the line has one rail
+// condition (the wheel-rail vehicle would multiply overlapping factors).
+std::vector<AdhesionSectionSpec> ReadAdhesionSections(const JsonNode& n) {
+  std::vector<AdhesionSectionSpec> out;
+  for (const auto& e : n.NonEmptyArray("no low-adhesion section")) {
+    AdhesionSectionSpec a;
+    a.entry = e.Path();
+    a.begin_mm = MetresToMm(e.Key("begin_m"));
+    const JsonNode en = e.Key("end_m");
+    a.end_mm = MetresToMm(en);
+    if (a.end_mm <= a.begin_mm) {
+      en.Fail("section end not after its begin");
+    }
+    if (!out.empty() && a.begin_mm < out.back().end_mm) {
+      e.Key("begin_m").Fail("section begins before the end of the previous one (" +
+                            FormatNumber(static_cast<double>(out.back().end_mm) / 1000.0) + " m): sections are sorted and disjoint");
+    }
+    if (auto r = e.OptKey("rail")) {
+      const std::string rail = r->String();
+      if (rail != "wet" && rail != "dry") {
+        r->Fail("unknown rail condition '" + rail + "' (wet, dry)");
+      }
+      a.wet = rail == "wet";
+    }
+    if (auto f = e.OptKey("factor")) {
+      a.factor = f->NumberIn({0.0, 1.0, true});
+    }
+    if (!a.wet && a.factor == 1.0) {
+      e.Fail("a dry section with factor 1 does not reduce the adhesion");
+    }
+    out.push_back(a);
+  }
+  return out;
 }
 
 }  // namespace
@@ -297,6 +337,19 @@ Scenario ParseScenario(std::string_view text, const std::string& file) {
     }
     sc.gap = g;
   }
+  if (auto la = root.OptKey("low_adhesion")) {
+    sc.low_adhesion = ReadAdhesionSections(la->Key("sections"));
+    if (auto tn = la->OptKey("trains")) {
+      sc.wheel_rail_trains.emplace();
+      for (const auto& e : tn->NonEmptyArray("no train (omit the key: every train)")) {
+        const std::int64_t id = e.Int();
+        if (std::none_of(sc.trains.begin(), sc.trains.end(), [&](const TrainSpec& t) { return t.id == id; })) {
+          e.Fail("unknown train " + std::to_string(id));
+        }
+        sc.wheel_rail_trains->push_back(static_cast<std::uint16_t>(id));
+      }
+    }
+  }
   return sc;
 }
 
@@ -348,6 +401,12 @@ void CheckScenarioAgainstLine(const Scenario& sc, const RunningLine& line) {
                         " mm) lies behind the train's previous position " + std::to_string(last) + " mm");
       }
       last = st->stop_mm;
+    }
+  }
+  for (const auto& a : sc.low_adhesion) {
+    if (a.end_mm > len) {
+      fail(a.entry, "low-adhesion section [" + std::to_string(a.begin_mm) + ", " + std::to_string(a.end_mm) +
+                        ") mm lies off running line '" + line.id + "' [0, " + std::to_string(len) + ")");
     }
   }
   for (const auto& f : sc.faults) {

@@ -37,14 +37,16 @@ ra::CycleInput SensorModel::Cycle(const TrueCycle& c) {
   const double dt = static_cast<double>(kCycleMs) / 1000.0;
   const std::int64_t t0_us = (c.time_ms - kCycleMs) * 1000;
   // tachogenerator: every pulse the wheel completes in the cycle, its edge at the exact time
-  const offline::Motion end = offline::Advance(c.start, c.accel_mps2, dt);
-  const double rolled = end.position - c.start.position;
+  const offline::Motion wheel = c.axle ? offline::Motion{c.start.position, c.axle->speed_mps} : c.start;
+  const double wheel_accel = c.axle ? c.axle->accel_mps2 : c.accel_mps2;
+  const offline::Motion end = offline::Advance(wheel, wheel_accel, dt);
+  const double rolled = end.position - wheel.position;
   const double before = wheel_m_;
   wheel_m_ += rolled;
   const auto pulses_now = static_cast<std::int64_t>(std::floor(wheel_m_ / pulse_m_));
   if (pulses_now > pulses_) {
     const double to_last = static_cast<double>(pulses_now) * pulse_m_ - before;
-    const double t = std::clamp(offline::TimeToCover(c.start.speed, c.accel_mps2, to_last), 0.0, dt);
+    const double t = std::clamp(offline::TimeToCover(wheel.speed, wheel_accel, to_last), 0.0, dt);
     const std::int64_t edge = t0_us + std::llround(t * 1e6);
     last_edge_us_ = std::max(edge, last_edge_us_ + 1);
     pulses_ = pulses_now;

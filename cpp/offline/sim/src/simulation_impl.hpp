@@ -37,6 +37,7 @@
 #include "railproof/sim/ground_line.hpp"
 #include "railproof/sim/sensors.hpp"
 #include "railproof/sim/simulation.hpp"
+#include "railproof/sim/wheel_rail_train.hpp"
 #include "railproof/units/onboard_unit.hpp"
 #include "railproof/units/wayside_unit.hpp"
 
@@ -111,6 +112,9 @@ struct TrainRt {
   std::int64_t length_mm = 0;
   Phase phase = Phase::kPending;
   Motion motion;  // the true front and speed
+  // the true motion where it is not the point mass's: the wheel-rail vehicle (low adhesion)
+  std::unique_ptr<WheelRailTrain> wheel_rail;
+  AxleState axle_state = AxleState::kRolling;  // its measured axle's, as last logged
   double previous_front_m = 0.0;  // before the last step
   // the on-board unit, its track database (per train type) and its inputs of the next cycle
   std::unique_ptr<units::OnboardUnit> unit;
@@ -309,8 +313,13 @@ struct Simulation::Impl {
   void CreateUnit(TrainRt& t, std::int64_t front_mm);
   void Enter(TrainRt& t);
   void Exit(TrainRt& t, const std::string& why);
-  // The sensor data of the cycle that ends at `end_ms` for a motion from `start` with `accel`.
-  void Sense(TrainRt& t, std::int64_t end_ms, const Motion& start, double accel);
+  // The sensor data of the cycle that ends at `end_ms` for a motion from `start` with `accel`
+  // (and the measured axle's own motion on the wheel-rail vehicle).
+  void Sense(TrainRt& t, std::int64_t end_ms, const Motion& start, double accel,
+             const std::optional<AxleMotion>& axle = std::nullopt);
+  // The true motion of one step under the equipment's applied acceleration `a` of the point
+  // mass: the point mass's, or the wheel-rail vehicle's (its achieved acceleration returned).
+  double Move(TrainRt& t, double a, double dt, std::optional<AxleMotion>& axle);
   void OnboardCycle(TrainRt& t);
   Control Drive(TrainRt& t, const units::OnboardOutputs& o, double dt);
   double Apply(TrainRt& t, const Control& c, double gradient, double dt) const;

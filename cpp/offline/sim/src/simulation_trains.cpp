@@ -1,5 +1,6 @@
 // Line scenario simulation: the trains: entry and exit, the on-board unit's cycle, the driver
-// and the brake equipment, the true motion (dynamics.hpp) and the sensors (sensors.hpp)
+// and the brake equipment, the true motion (dynamics.hpp, or the wheel-rail vehicle where the
+// scenario has low adhesion: wheel_rail_train.hpp) and the sensors (sensors.hpp)
 // (simulation_impl.hpp).
 #include "simulation_impl.hpp"
 
@@ -103,6 +104,9 @@ void Simulation::Impl::Enter(TrainRt& t) {
   t.entered_ms = now;
   t.motion = Motion{ToM(t.spec.initial_front_mm), 0.0};
   t.start_m = t.motion.position;
+  if (sc.OnWheelRail(t.spec.id)) {
+    t.wheel_rail = MakeWheelRailTrain(sc, t.spec, *rl, t.motion.position);
+  }
   CreateUnit(t, t.spec.initial_front_mm);
   Emit(Json{{"ev", "enter"}, {"train", t.spec.id}, {"front_mm", t.spec.initial_front_mm}, {"length_mm", t.length_mm},
             {"train_type", t.type->name}});
@@ -117,13 +121,34 @@ void Simulation::Impl::Exit(TrainRt& t, const std::string& why) {
   Emit(Json{{"ev", "exit"}, {"train", t.spec.id}, {"front_mm", t.FrontMm()}, {"reason", why}});
 }
 
-void Simulation::Impl::Sense(TrainRt& t, std::int64_t end_ms, const Motion& start, double accel) {
+void Simulation::Impl::Sense(TrainRt& t, std::int64_t end_ms, const Motion& start, double accel,
+                             const std::optional<AxleMotion>& axle) {
   TrueCycle c;
   c.time_ms = end_ms;
   c.start = start;
   c.accel_mps2 = accel;
-  c.gradient_permille = MeanGradient(start.position - t.spec.performance.length_m, start.position);
+  // the IMU rides on the car whose motion it is: the wheel-rail vehicle's, or the train's
+  const double length = t.wheel_rail ? t.wheel_rail->CarLengthM() : t.spec.performance.length_m;
+  c.gradient_permille = MeanGradient(start.position - length, start.position);
+  c.axle = axle;
   t.next_sensors = t.sensors->Cycle(c);
+}
+
+double Simulation::Impl::Move(TrainRt& t, double a, double dt, std::optional<AxleMotion>& axle) {
+  if (!t.wheel_rail) {
+    t.motion = offline::Advance(t.motion, a, dt);
+    return a;
+  }
+  const WheelRailStep w = t.wheel_rail->Step(t.applied_mps2, ToS(now), dt);
+  t.motion = w.end;
+  axle = w.axle;
+  if (w.state != t.axle_state) {
+    t.axle_state = w.state;
+    Emit(Json{{"ev", "axle"}, {"train", t.spec.id}, {"state", ToString(w.state)}, {"creep", R2(w.creep)},
+              {"speed_mps", R2(w.end.speed)}, {"axle_speed_mps", R2(w.axle.speed_mps + w.axle.accel_mps2 * dt)},
+              {"front_mm", t.FrontMm()}});
+  }
+  return w.accel_mps2;
 }
 
 // One cycle of the train's on-board unit with what reached it since the last one; its
@@ -367,7 +392,8 @@ void Simulation::Impl::MoveTrains() {
     const double a = Apply(t, c, grad, dt);
     const Motion before = t.motion;
     t.previous_front_m = before.position;
-    t.motion = offline::Advance(before, a, dt);
+    std::optional<AxleMotion> axle;
+    const double achieved = Move(t, a, dt, axle);
     // a balise the true front passed is read in the next cycle
     while (t.next_balise_index < rl->balises.size() &&
            t.FrontMm() >= rl->balises[t.next_balise_index].position_mm) {
@@ -377,7 +403,7 @@ void Simulation::Impl::MoveTrains() {
       }
       ++t.next_balise_index;
     }
-    Sense(t, now + sc.step_ms, before, a);
+    Sense(t, now + sc.step_ms, before, achieved, axle);
     t.max_speed = std::max(t.max_speed, t.motion.speed);
     if (t.phase == Phase::kRunning && t.motion.speed <= 0.0 && !o.authority_usable) {
       t.standstill_no_authority_ms += sc.step_ms;

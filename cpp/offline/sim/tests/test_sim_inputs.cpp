@@ -229,6 +229,24 @@ TEST(SimScenarioFile, BadScenarioFilesGiveOneLineErrorsNamingTheEntry) {
   ExpectScenarioError([](auto& j) { j["line"] = "other_line"; }, {"line: the scenario names line 'other_line'"}, true);
   ExpectScenarioError([](auto& j) { j["faults"] = {{{"type", "siding_request"}, {"route", 7}, {"from_s", 1}, {"to_s", 2}}}; },
                       {"faults[0]", "unknown route 7"}, true);
+  // low-adhesion sections: sorted and disjoint, a condition that reduces the adhesion, known
+  // trains, on the line
+  const auto sections = [](auto& j, const nlohmann::json& s) { j["low_adhesion"] = {{"sections", s}}; };
+  ExpectScenarioError([&](auto& j) { sections(j, {{{"begin_m", 500}, {"end_m", 400}}}); },
+                      {"low_adhesion.sections[0].end_m", "section end not after its begin"});
+  ExpectScenarioError([&](auto& j) { sections(j, {{{"begin_m", 500}, {"end_m", 900}}, {{"begin_m", 800}, {"end_m", 1000}}}); },
+                      {"low_adhesion.sections[1].begin_m", "before the end of the previous one (900 m)"});
+  ExpectScenarioError([&](auto& j) { sections(j, {{{"begin_m", 500}, {"end_m", 900}, {"rail", "icy"}}}); },
+                      {"low_adhesion.sections[0].rail", "unknown rail condition 'icy'"});
+  ExpectScenarioError([&](auto& j) { sections(j, {{{"begin_m", 500}, {"end_m", 900}, {"factor", 0}}}); },
+                      {"low_adhesion.sections[0].factor", "outside (0, 1]"});
+  ExpectScenarioError([&](auto& j) { sections(j, {{{"begin_m", 500}, {"end_m", 900}, {"rail", "dry"}}}); },
+                      {"low_adhesion.sections[0]", "does not reduce the adhesion"});
+  ExpectScenarioError([&](auto& j) { sections(j, nlohmann::json::array()); }, {"low_adhesion.sections", "no low-adhesion section"});
+  ExpectScenarioError([&](auto& j) { sections(j, {{{"begin_m", 500}, {"end_m", 900}}}); j["low_adhesion"]["trains"] = {9}; },
+                      {"low_adhesion.trains[0]", "unknown train 9"});
+  ExpectScenarioError([&](auto& j) { sections(j, {{{"begin_m", 9500}, {"end_m", 10500}}}); },
+                      {"low_adhesion.sections[0]", "low-adhesion section [9500000, 10500000) mm lies off running line 'up'"}, true);
 }
 
 // Huge but finite values: refused before a conversion to mm or ms, and before they can turn

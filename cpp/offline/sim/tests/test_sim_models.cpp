@@ -173,7 +173,7 @@ TEST(SimSensors, TheOdometryTracksTheTrueMotionInsideItsEnvelope) {
     for (int k = 0; k < 1200; ++k) {  // 120 s
       t += 100;
       const double a = k < 60 ? 0.0 : (k < 260 ? 0.5 : (k < 900 ? 0.0 : -0.8));
-      TrueCycle c{t, truth, a, 0.0, std::nullopt};
+      TrueCycle c{t, truth, a, 0.0, std::nullopt, std::nullopt};
       const offline::Motion next = offline::Advance(truth, a, 0.1);
       if (!balise_passed && next.position >= 1500.0) {
         balise_passed = true;
@@ -206,7 +206,7 @@ TEST(SimSensors, StreamsFollowTheTrueMotion) {
   sc.imu_rate_noise_rad_s = 0.0;
   SensorModel s(sc);
   const offline::Motion m{0.0, 10.0};
-  const ra::CycleInput in = s.Cycle(TrueCycle{100, m, 0.0, 20.0, std::nullopt});
+  const ra::CycleInput in = s.Cycle(TrueCycle{100, m, 0.0, 20.0, std::nullopt, std::nullopt});
   EXPECT_EQ(in.tg.pulses, static_cast<std::int64_t>(std::floor(1.0 / s.true_pulse_m())));
   EXPECT_GT(in.tg.last_edge_us, 0);
   EXPECT_LE(in.tg.last_edge_us, 100'000);

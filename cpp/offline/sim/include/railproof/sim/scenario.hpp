@@ -77,6 +77,17 @@ struct GapSpec {
 
 enum class MarginPolicy : std::uint8_t { kReported, kD2 };
 
+// A section of reduced adhesion (wet rail, leaves): the rail's adhesion in [begin, end) is the
+// dry rail's times the wet rail's factor (wet) times `factor`. The trains that run on the
+// wheel-rail vehicle (spec/design/sim.md) feel it; a point-mass train rolls on dry rail.
+struct AdhesionSectionSpec {
+  std::int64_t begin_mm = 0;
+  std::int64_t end_mm = 0;
+  bool wet = true;
+  double factor = 1.0;  // (0, 1]
+  std::string entry;
+};
+
 struct Scenario {
   std::string file;
   std::string name;
@@ -96,6 +107,14 @@ struct Scenario {
   std::vector<TrainSpec> trains;  // after expanding "repeat"
   std::vector<FaultSpec> faults;
   std::optional<GapSpec> gap;
+  // low_adhesion: its sections (sorted, disjoint) and the trains on the wheel-rail vehicle
+  // (every train when the scenario names none).
+  std::vector<AdhesionSectionSpec> low_adhesion;
+  std::optional<std::vector<std::uint16_t>> wheel_rail_trains;
+
+  // Whether train `id` runs on the wheel-rail vehicle (the scenario has low-adhesion sections
+  // and names the train, or names none).
+  [[nodiscard]] bool OnWheelRail(std::uint16_t id) const;
 };
 
 // Parses and validates a scenario text (not yet against a line). `file` names it in messages.

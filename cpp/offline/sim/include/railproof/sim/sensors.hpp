@@ -11,8 +11,10 @@
 //                   simulator's ASM-027 levels; the system simulation is not an odometry
 //                   study, whose errors cpp/offline/ra exercises);
 //   balise          the fix of a balise the front passed during the cycle (line position).
-// No slip or slide: the wheel rolls with the train (adhesion is the wheel-rail simulator's
-// subject, cpp/offline/ra; the system simulation runs on dry rail, stated in the scenarios).
+// The TG wheel rolls with the train unless the cycle gives the measured axle's own motion: a
+// train on the wheel-rail vehicle (wheel_rail_train.hpp), whose axle slips under traction and
+// slides under braking on a low-adhesion section; its pulses and edge times are derived from
+// that motion the same way, the IMU from the car body's.
 //
 // Offline module; deterministic for a seed.
 #pragma once
@@ -37,6 +39,12 @@ struct SensorConfig {
   std::uint64_t seed = 1;
 };
 
+// The measured axle's surface speed over a cycle: at its start and its constant change.
+struct AxleMotion {
+  double speed_mps = 0.0;
+  double accel_mps2 = 0.0;
+};
+
 // One cycle's true motion: the front at the cycle's start, the constant acceleration over
 // the cycle (the simulator's step), and the mean gradient under the train (per mille).
 struct TrueCycle {
@@ -45,6 +53,7 @@ struct TrueCycle {
   double accel_mps2 = 0.0;
   double gradient_permille = 0.0;
   std::optional<std::int64_t> balise_mm;  // a balise the front passed in the cycle
+  std::optional<AxleMotion> axle;         // the TG axle's own motion (else it rolls with the train)
 };
 
 class SensorModel {
