@@ -140,9 +140,10 @@ ConfigCheck OnboardUnit::Init(const OnboardConfig& c) noexcept {
   if (const ConfigCheck areas = InitAreas(c); areas.error != OnboardConfigError::kNone) {
     return areas;
   }
-  // the first link: the area holding the initial front (the last origin at or before it)
+  // the first link: the unit protecting the initial front (the last area whose previous
+  // boundary lies at or before it; a front in a handover zone opens the next link at once)
   std::size_t area = 0;
-  while (area + 1 < areas_.Size() && areas_[area + 1].origin_mm <= c.initial_front_mm) {
+  while (area + 1 < areas_.Size() && *areas_[area].boundary_mm <= c.initial_front_mm) {
     ++area;
   }
   if (const tg::ConfigError e = Open(First(), area); e != tg::ConfigError::kNone) {

@@ -10,6 +10,7 @@
 #include <memory>
 #include <optional>
 #include <span>
+#include <tuple>
 #include <vector>
 
 #include "onboard_rig.hpp"
@@ -219,6 +220,32 @@ TEST(OnboardHandover, LostLinkToTheNextUnitBrakesAtTheBoundary) {
   ASSERT_TRUE(out.indications.limit_mm.has_value());
   EXPECT_LE(*out.indications.limit_mm, kBoundary);
   EXPECT_EQ(out.indications.obstruction, messages::Obstruction::kSystemBoundary);
+}
+
+// A train starting in the handover zone starts with the unit before (the one protecting its
+// front) and opens the next link once its position is valid; past the boundary it starts with
+// the next unit alone.
+TEST(OnboardHandover, TheFirstLinkIsTheUnitProtectingTheInitialFront) {
+  Line line;
+  const std::vector<RadioArea> areas{{kRadioA, 0, kBoundary}, {kRadioB, kOriginB, std::nullopt}};
+  for (const auto& [front, first, next] : {std::tuple{1'700'000, 0U, std::optional<std::size_t>(1)},
+                                           std::tuple{2'100'000, 1U, std::optional<std::size_t>()}}) {
+    OnboardConfig c = Config(line);
+    c.initial_front_mm = front;
+    c.radio_areas = areas;
+    auto created = OnboardUnit::Create(c);
+    ASSERT_TRUE(created.unit.has_value());
+    ra::test::Stream stream;
+    for (int k = 0; k < ra::test::kWarmupCycles + 2; ++k) {
+      OnboardInputs in;
+      in.sensors = stream.Next();
+      in.now_ms = in.sensors.time_ms;
+      (void)created.unit->Cycle(in);
+    }
+    EXPECT_TRUE(created.unit->Outputs().position_valid);
+    EXPECT_EQ(created.unit->Outputs().radio_area, first) << front;
+    EXPECT_EQ(created.unit->Outputs().handover_area, next) << front;
+  }
 }
 
 TEST(OnboardHandover, RefusesBadRadioAreasWithTheirReason) {
