@@ -26,8 +26,6 @@ double MaxTraction(const TrainPerformance& perf, double speed_mps) {
   return perf.accel_mps2;
 }
 
-double CurveResistancePermille(double radius_m) { return radius_m > 0.0 ? 800.0 / radius_m : 0.0; }
-
 double GradeDecel(double gradient_permille, double gravity) { return gravity * gradient_permille / 1000.0; }
 
 double NetAcceleration(const TrainPerformance& perf, const Control& control, double speed_mps,

@@ -48,7 +48,8 @@
 //                             motion has none); SI units, gravity kGravity.
 // Not this model: the Box2D wheel-rail simulator (ra) is multi-body creep physics (car body,
 // bogies, wheelsets, slip-dependent adhesion per wheelset): slip and slide, its subject, do
-// not exist for a point mass.
+// not exist for a point mass. The system simulator puts a scenario's trains on it where the
+// scenario declares low adhesion (ra::analysis::WheelRailVehicle, spec/design/sim.md).
 //
 // Offline module.
 #pragma once
@@ -115,8 +116,9 @@ double ResistanceDecel(const Resistance& r, double speed_mps);
 
 // Curve resistance of a curve of `radius_m` (> 0) in N/kN, that is per mille of the train's
 // weight, the same unit as a rising gradient: 800 / R, the narrow-gauge handbook form
-// (ASM-034).
-double CurveResistancePermille(double radius_m);
+// (ASM-034). Inline: the line loader's mean under the train uses it, and the loaders are also
+// built alone for fuzzing.
+inline double CurveResistancePermille(double radius_m) { return radius_m > 0.0 ? 800.0 / radius_m : 0.0; }
 
 // Deceleration by gravity on a gradient of `gradient_permille` (+ rising; negative on a
 // falling gradient) in the unit of `gravity`: gravity * i / 1000.
