@@ -54,7 +54,7 @@ bool Prng::Bernoulli(double p) { return Uniform() < p; }
 Channel::Channel(const ChannelConfig& config, std::uint64_t seed) : config_(config), prng_(seed) {}
 
 bool Channel::Send(std::uint16_t train, Direction direction, std::int64_t now_ms, std::span<const std::uint8_t> bytes,
-                   bool blocked) {
+                   bool blocked, std::size_t wayside) {
   ChannelStats& st = direction == Direction::kUplink ? up_ : down_;
   ++st.sent;
   if (blocked) {
@@ -70,6 +70,7 @@ bool Channel::Send(std::uint16_t train, Direction direction, std::int64_t now_ms
   }
   Frame f;
   f.train = train;
+  f.wayside = wayside;
   f.direction = direction;
   f.sent_ms = now_ms;
   f.due_ms = now_ms + delay;

@@ -95,6 +95,69 @@ GroundLine BuildGroundLine(const Line& line, const RunningLine& rl, mb::wayside:
   return gl;
 }
 
+RunningLine AreaOfRunningLine(const RunningLine& rl, std::int64_t begin_mm, std::int64_t end_mm,
+                              std::optional<std::int64_t> boundary_mm, const std::string& where) {
+  const auto fail = [&](const std::string& reason) { throw InputError(where + ": " + reason); };
+  const auto on_block = [&](std::int64_t x) { return std::binary_search(rl.blocks_mm.begin(), rl.blocks_mm.end(), x); };
+  if (!on_block(begin_mm) || !on_block(end_mm)) {
+    fail("the unit's line [" + std::to_string(begin_mm) + ", " + std::to_string(end_mm) +
+         "] mm must begin and end at virtual-block boundaries of running line '" + rl.id + "'");
+  }
+  // an item inside the part, shifted; none outside it; an item across an end refused
+  const auto part = [&](const Section& s, const std::string& item) -> std::optional<Section> {
+    if (s.end_mm <= begin_mm || s.begin_mm >= end_mm) {
+      return std::nullopt;
+    }
+    if (s.begin_mm < begin_mm || s.end_mm > end_mm) {
+      fail(item + " [" + std::to_string(s.begin_mm) + ", " + std::to_string(s.end_mm) + "] mm crosses an end of the unit's line [" +
+           std::to_string(begin_mm) + ", " + std::to_string(end_mm) + "] mm");
+    }
+    return Section{s.begin_mm - begin_mm, s.end_mm - begin_mm};
+  };
+  RunningLine a;
+  a.id = rl.id;
+  a.length_mm = end_mm - begin_mm;
+  for (const std::int64_t b : rl.blocks_mm) {
+    if (b >= begin_mm && b <= end_mm) {
+      a.blocks_mm.push_back(b - begin_mm);
+    }
+  }
+  for (const Station& s : rl.stations) {
+    if (const auto p = part(s.platform, "the platform of station " + s.name)) {
+      Station c = s;
+      c.platform = *p;
+      c.stop_mm -= begin_mm;
+      a.stations.push_back(c);
+    }
+  }
+  for (const Section& s : rl.no_stop_sections) {
+    if (const auto p = part(s, "a no-stop section")) {
+      a.no_stop_sections.push_back(*p);
+    }
+  }
+  for (const Points& pt : rl.points) {
+    if (const auto p = part(pt.section, "points " + pt.id)) {
+      a.points.push_back(Points{pt.id, *p});
+    }
+  }
+  for (const Route& r : rl.routes) {
+    if (const auto p = part(r.section, "route " + std::to_string(r.id))) {
+      Route c = r;
+      c.section = *p;
+      a.routes.push_back(c);
+    }
+  }
+  for (const Handover& h : rl.handovers) {
+    if (h.position_mm > begin_mm && h.position_mm < end_mm) {
+      a.handovers.push_back(Handover{h.id, h.position_mm - begin_mm});
+    }
+  }
+  if (boundary_mm) {
+    a.system_boundary_mm = *boundary_mm - begin_mm;
+  }
+  return a;
+}
+
 mb::wayside::Capacity GroundCapacity(const GroundLine& gl, std::size_t trains) {
   mb::wayside::Capacity cap = mb::wayside::DefaultCapacity();
   cap.trains = std::max<std::size_t>(1, trains);

@@ -251,6 +251,19 @@ Scenario ParseScenario(std::string_view text, const std::string& file) {
   if (auto b = root.OptKey("boundary_accepted")) {
     sc.boundary_accepted = b->Bool();
   }
+  if (auto ws = root.OptKey("wayside_splits")) {
+    for (const auto& n : ws->Array()) {
+      WaysideSplit s;
+      s.at_mm = MetresToMm(n.Key("at_m"));
+      s.overlap_mm = n.Key("overlap_m").ScaledIn({0.0, kPosition.hi, true}, 1000.0, "m");
+      s.entry = n.Path();
+      if (!sc.wayside_splits.empty() &&
+          s.at_mm - s.overlap_mm <= sc.wayside_splits.back().at_mm + sc.wayside_splits.back().overlap_mm) {
+        n.Key("at_m").Fail("the handover zone must begin after the previous split's overlap ends");
+      }
+      sc.wayside_splits.push_back(s);
+    }
+  }
   if (auto sm = root.OptKey("sample_ms")) {
     sc.sample_ms = PositiveMs(*sm);
     if (sc.sample_ms % sc.step_ms != 0) {

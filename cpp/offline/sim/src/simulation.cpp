@@ -173,22 +173,139 @@ void Simulation::Impl::SetupOnboardLine() {
 }
 
 void Simulation::Impl::SetupWayside() {
-  units::WaysideConfig c;
-  c.radio_id = kGroundId;
-  c.radio = tg::DeploymentConfig(tg::Role::kGround, kGroundId, static_cast<std::uint16_t>(kGroundId + 1));
-  c.keys = &KeyOf;
-  c.key_context = &trains;
-  c.line = gl.config;
-  c.capacity = GroundCapacity(gl, sc.trains.size());
-  c.secure_ahead_mm = ToMm(sc.handover_secure_ahead_m);
-  c.crossings = obl.crossings;
-  auto created = units::WaysideUnit::Create(c);
-  if (created.error != units::ConfigError::kNone) {
-    throw InputError(line.file + ": running line '" + rl->id + "': the wayside unit refuses the line: " +
-                     units::ToString(created.error) + " (" + mb::wayside::ToString(created.line_error) + ", entry " +
-                     std::to_string(created.entry) + ")");
+  SplitWayside();
+  for (std::size_t k = 0; k < waysides.size(); ++k) {
+    WaysideRt& w = waysides[k];
+    units::WaysideConfig c;
+    c.radio_id = w.radio_id;
+    c.radio = tg::DeploymentConfig(tg::Role::kGround, w.radio_id, static_cast<std::uint16_t>(w.radio_id + 1));
+    c.keys = &KeyOf;
+    c.key_context = &trains;
+    c.line = w.gl.config;
+    c.capacity = GroundCapacity(w.gl, sc.trains.size());
+    c.secure_ahead_mm = ToMm(sc.handover_secure_ahead_m);
+    c.crossings = w.crossings;
+    c.origin_mm = w.origin_mm;
+    if (k + 1 < waysides.size()) {
+      c.handover_zone_begin_mm = waysides[k + 1].origin_mm - w.origin_mm;
+    }
+    auto created = units::WaysideUnit::Create(c);
+    if (created.error != units::ConfigError::kNone) {
+      throw InputError(line.file + ": running line '" + rl->id + "'" +
+                       (k > 0 ? ": the wayside unit after " + sc.wayside_splits[k - 1].entry : std::string()) +
+                       ": the wayside unit refuses the line: " + units::ToString(created.error) + " (" +
+                       mb::wayside::ToString(created.line_error) + ", entry " + std::to_string(created.entry) + ")");
+    }
+    w.unit = std::move(created.unit);
   }
-  wayside = std::move(created.unit);
+  wayside = waysides.front().unit.get();
+}
+
+// Without splits one unit holds the whole line (gl, every crossing). With splits, unit k holds
+// [origin_k, end_k]: origin_0 = 0, origin_k = at - overlap of split k-1; end_k = at + overlap of
+// split k, the line's end for the last; its system boundary is split k's at (the running
+// line's own for the last). A crossing belongs to the unit between the boundaries around it;
+// points and routes must lie before the first handover zone (the scenario's commands and the
+// points' bookkeeping use the first unit).
+void Simulation::Impl::SplitWayside() {
+  const auto& splits = sc.wayside_splits;
+  std::vector<std::size_t> all(crossings.size());
+  for (std::size_t i = 0; i < all.size(); ++i) {
+    all[i] = i;
+  }
+  if (splits.empty()) {
+    WaysideRt w;
+    w.gl = gl;
+    w.radio_id = kGroundId;
+    w.crossings = obl.crossings;
+    w.crossing_index = all;
+    waysides.push_back(std::move(w));
+    return;
+  }
+  std::int64_t longest = 0;
+  for (const auto& t : trains) {
+    longest = std::max(longest, t->length_mm);
+  }
+  for (const WaysideSplit& s : splits) {
+    const auto where = [&](const std::string& reason) { return InputError(sc.file + ": " + s.entry + ": " + reason); };
+    if (s.at_mm - s.overlap_mm <= 0 || s.at_mm + s.overlap_mm > rl->length_mm) {
+      throw where("the handover zone [" + Fmt(ToM(s.at_mm - s.overlap_mm)) + ", " + Fmt(ToM(s.at_mm + s.overlap_mm)) +
+                  "] m lies off running line '" + rl->id + "'");
+    }
+    if (s.overlap_mm < longest) {
+      throw where("overlap_m " + Fmt(ToM(s.overlap_mm)) + " is shorter than the longest train (" + Fmt(ToM(longest)) +
+                  " m): the unit before must hold a train until its rear has passed the boundary");
+    }
+    if (rl->system_boundary_mm && *rl->system_boundary_mm <= s.at_mm + s.overlap_mm) {
+      throw where("the split lies at or past the running line's system boundary");
+    }
+  }
+  const std::int64_t first_zone = splits.front().at_mm - splits.front().overlap_mm;
+  for (const auto& p : rl->points) {
+    if (p.section.end_mm > first_zone) {
+      throw InputError(sc.file + ": " + splits.front().entry + ": points " + p.id +
+                       " lie in or after the first handover zone (they must belong to the first wayside unit)");
+    }
+  }
+  for (const FaultSpec& f : sc.faults) {
+    const bool on_track = f.type == FaultType::kPossession || f.type == FaultType::kSpeedRestriction;
+    if (on_track && f.end_mm > first_zone) {
+      throw InputError(sc.file + ": " + f.entry + ": with wayside_splits a " + ToString(f.type) +
+                       " must lie before the first handover zone (the first wayside unit takes the commands)");
+    }
+  }
+  for (std::size_t k = 0; k <= splits.size(); ++k) {
+    WaysideRt w;
+    w.origin_mm = k == 0 ? 0 : splits[k - 1].at_mm - splits[k - 1].overlap_mm;
+    const std::int64_t end = k < splits.size() ? splits[k].at_mm + splits[k].overlap_mm : rl->length_mm;
+    const std::optional<std::int64_t> boundary = k < splits.size() ? std::optional(splits[k].at_mm) : rl->system_boundary_mm;
+    const std::string& entry = splits[k < splits.size() ? k : k - 1].entry;
+    w.line = AreaOfRunningLine(*rl, w.origin_mm, end, boundary, sc.file + ": " + entry);
+    w.gl = BuildGroundLine(line, w.line,
+                           sc.margin_policy == MarginPolicy::kD2 ? mb::wayside::MarginPolicy::kD2Buffers
+                                                                 : mb::wayside::MarginPolicy::kReportedCorrection,
+                           sc.ground_cycle_ms);
+    // the first keeps the line's ground id; the others count down from the top of the ids
+    w.radio_id = k == 0 ? kGroundId : static_cast<std::uint16_t>(0xFFFF - (k - 1));
+    if (Find(w.radio_id) != nullptr) {
+      throw InputError(sc.file + ": " + entry + ": train id " + std::to_string(w.radio_id) +
+                       " is the radio id of a wayside unit");
+    }
+    const std::int64_t own_begin = k == 0 ? 0 : splits[k - 1].at_mm;
+    const std::int64_t own_end = k < splits.size() ? splits[k].at_mm : rl->length_mm + 1;
+    for (std::size_t i = 0; i < crossings.size(); ++i) {
+      const CrossingRt& x = crossings[i];
+      if (x.near_mm < own_begin && x.far_mm >= own_begin) {
+        throw InputError(sc.file + ": " + entry + ": level crossing " + x.name + " lies across the boundary");
+      }
+      if (x.near_mm >= own_begin && x.near_mm < own_end) {
+        const lc::CrossingData& d = obl.crossings[i];
+        w.crossings.push_back(lc::CrossingData{d.id, d.near_mm - w.origin_mm, d.far_mm - w.origin_mm, d.warning_time_ms});
+        w.crossing_index.push_back(i);
+      }
+    }
+    radio_areas.push_back(units::RadioArea{w.radio_id, w.origin_mm, boundary});
+    waysides.push_back(std::move(w));
+  }
+  radio_areas.back().boundary_mm.reset();  // no neighbour past the last: the train has no link to hand over to
+}
+
+std::size_t Simulation::Impl::WaysideAt(std::int64_t front_mm) const {
+  std::size_t k = 0;
+  while (k + 1 < waysides.size() && *radio_areas[k].boundary_mm <= front_mm) {
+    ++k;
+  }
+  return k;
+}
+
+std::optional<std::int64_t> Simulation::Impl::ProtectedAuthority(std::uint16_t train) const {
+  std::optional<std::int64_t> best;
+  for (const WaysideRt& w : waysides) {
+    if (const auto p = w.unit->Ground().ProtectedAuthority(train)) {
+      best = std::max(best.value_or(*p + w.origin_mm), *p + w.origin_mm);
+    }
+  }
+  return best;
 }
 
 void Simulation::Impl::Emit(Json ev) {

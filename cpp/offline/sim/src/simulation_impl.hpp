@@ -103,6 +103,21 @@ struct OnboardLine {
   std::vector<ra::OdometrySection> sections;
 };
 
+// One wayside unit of the running line (several with the scenario's wayside_splits): the part
+// of the line it holds in its own chainage (from origin_mm), its crossings (indices into
+// Impl::crossings) and the neighbour messages of its last ground cycle.
+struct WaysideRt {
+  RunningLine line;
+  GroundLine gl;
+  std::unique_ptr<units::WaysideUnit> unit;
+  std::int64_t origin_mm = 0;
+  std::uint16_t radio_id = 0;
+  std::vector<lc::CrossingData> crossings;
+  std::vector<std::size_t> crossing_index;
+  std::vector<units::HandoverRequest> requests;    // to the next unit
+  std::vector<units::HandoverResponse> responses;  // to the previous unit
+};
+
 // The brake the train's equipment applies (from the unit's demand and the driver).
 enum class Brake : std::uint8_t { kNone, kDriver, kService, kEmergency };
 
@@ -123,6 +138,7 @@ struct TrainRt {
   ra::CycleInput next_sensors{};
   std::optional<std::uint32_t> next_balise;
   std::vector<std::vector<std::uint8_t>> inbox;  // frames received for the next cycle
+  std::vector<std::vector<std::uint8_t>> handover_inbox;  // those of the next wayside unit
   std::size_t next_balise_index = 0;             // the next balise the true front reaches
   std::array<std::uint8_t, tg::kKeyBytes> key{};
   // driver and brake equipment
@@ -226,7 +242,12 @@ struct Simulation::Impl {
   const RunningLine* rl = nullptr;
   GroundLine gl;
   OnboardLine obl;
-  std::unique_ptr<units::WaysideUnit> wayside;
+  // the wayside units along the running line, and the first (the only one without splits):
+  // the one that takes the scenario's commands
+  std::vector<WaysideRt> waysides;
+  units::WaysideUnit* wayside = nullptr;
+  std::vector<units::RadioArea> radio_areas;  // the on-board units' (none with one unit)
+  std::uint64_t handovers = 0;                // trains released to the next unit
   Channel channel;
   std::vector<std::unique_ptr<TrainRt>> trains;
   std::vector<FaultRt> faults;
@@ -277,6 +298,14 @@ struct Simulation::Impl {
   [[nodiscard]] const TrainType* TrainTypeOf(const TrainSpec& spec) const;
   void SetupOnboardLine();
   void SetupWayside();
+  // The wayside units of the scenario's splits (one without): their lines, crossings, radio
+  // areas; InputError naming the split entry.
+  void SplitWayside();
+  // The unit protecting a front (the last whose previous boundary lies at or before it), as the
+  // on-board unit picks its first link; in a handover zone the unit before hands it over.
+  [[nodiscard]] std::size_t WaysideAt(std::int64_t front_mm) const;
+  // The largest authority a wayside unit holding the train protects for it (line chainage).
+  [[nodiscard]] std::optional<std::int64_t> ProtectedAuthority(std::uint16_t train) const;
   [[nodiscard]] const mb::wayside::Ground& Ground() const { return wayside->Ground(); }
   // Writes one event to the log (if any), stamped with the time.
   void Emit(Json ev);
@@ -300,6 +329,8 @@ struct Simulation::Impl {
   // Frames due now: a train's telegram to the wayside unit, the unit's to the train's inbox.
   void DeliverFrames();
   void GroundCycle();
+  void WaysideOutput(std::size_t k, const units::CycleOutput& out, const std::vector<bool>& before, Json& cyc);
+  void GroundState(const std::vector<bool>& before);
   void CrossingEquipment(const units::CycleOutput& out);
 
   // ---- entry and exit, the on-board unit, the driver, motion and sensors (simulation_trains.cpp)

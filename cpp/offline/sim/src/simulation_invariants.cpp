@@ -80,7 +80,7 @@ void Simulation::Impl::CheckInvariants() {
     }
     // REQ-MB-009: the usable on-board authority lies within what the ground protects
     ++checks["REQ-MB-009"].checks;
-    const auto prot = Ground().ProtectedAuthority(t.spec.id);
+    const auto prot = ProtectedAuthority(t.spec.id);
     if (!prot || *lim > *prot) {
       Violate("REQ-MB-009", id,
               "train " + id + " usable limit " + std::to_string(*lim) + " mm beyond the ground's protected authority " +

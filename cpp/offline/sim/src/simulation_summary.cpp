@@ -216,6 +216,11 @@ nlohmann::ordered_json Simulation::Summary() const {
                      {"stop_limit_telegrams", s.telegrams_issued},
                      {"reports", rs},
                      {"tracking_abnormal_events", s.abnormal_events}};
+  if (s.waysides.size() > 1) {
+    // the split line: its units and the trains one released to the next
+    j["ground"]["wayside_units"] = s.waysides.size();
+    j["ground"]["handovers"] = s.handovers;
+  }
   Json br = Json::object();
   for (const auto& [k, v] : s.brake_reasons) {
     br[k] = v;

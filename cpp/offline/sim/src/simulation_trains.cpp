@@ -36,7 +36,7 @@ bool Simulation::Impl::EntryClear(const TrainRt& n) const {
       return false;
     }
     if (u->FrontMm() <= front) {
-      const auto prot = Ground().ProtectedAuthority(u->spec.id);
+      const auto prot = ProtectedAuthority(u->spec.id);
       if (prot && *prot > rear - m) {
         return false;
       }
@@ -65,6 +65,7 @@ void Simulation::Impl::CreateUnit(TrainRt& t, std::int64_t front_mm) {
   c.line = units::LineData{obl.blocks_mm, obl.gradients, t.limits, obl.balises, obl.crossings, obl.sections};
   c.crossing = lc::onboard::DefaultProtectionConfig(t.spec.id, t.length_mm, c.train.accel_max_mm_s2);
   c.radio = tg::DeploymentConfig(tg::Role::kTrain, t.spec.id, kGroundId);
+  c.radio_areas = radio_areas;
   c.link_key.emplace(t.key);
   c.radio_period_ms = sc.report_period_ms;
   // spread the trains' telegrams over the period
@@ -81,6 +82,7 @@ void Simulation::Impl::CreateUnit(TrainRt& t, std::int64_t front_mm) {
   s.seed = sc.seed ^ (0x5E5E5E5E00000000ULL + t.spec.id * 0x9E3779B97F4A7C15ULL);
   t.sensors = std::make_unique<SensorModel>(s);
   t.inbox.clear();
+  t.handover_inbox.clear();
   t.driver = {};
   t.next_balise.reset();
   t.next_balise_index = 0;
@@ -91,10 +93,11 @@ void Simulation::Impl::CreateUnit(TrainRt& t, std::int64_t front_mm) {
 }
 
 void Simulation::Impl::Enter(TrainRt& t) {
-  const auto admitted = wayside->Admit(t.spec.id, t.spec.id);
-  const mb::wayside::TrainRegistration reg{t.spec.id, t.length_mm, t.spec.initial_front_mm, 0,
+  const WaysideRt& w = waysides[WaysideAt(t.spec.initial_front_mm)];
+  const auto admitted = w.unit->Admit(t.spec.id, t.spec.id);
+  const mb::wayside::TrainRegistration reg{t.spec.id, t.length_mm, t.spec.initial_front_mm - w.origin_mm, 0,
                                            mb::wayside::InitialPosition::kEntryBalise};
-  const auto st = admitted == units::AdmitStatus::kAdmitted ? wayside->Register(reg) : units::RegisterResult{};
+  const auto st = admitted == units::AdmitStatus::kAdmitted ? w.unit->Register(reg) : units::RegisterResult{};
   if (admitted != units::AdmitStatus::kAdmitted || st.status != units::RegisterStatus::kRegistered) {
     throw InputError(sc.file + ": " + t.spec.entry + ": the wayside unit refuses the train (" +
                      units::ToString(admitted) + ", " + units::ToString(st.status) + ", ground " +
@@ -113,7 +116,9 @@ void Simulation::Impl::Enter(TrainRt& t) {
 }
 
 void Simulation::Impl::Exit(TrainRt& t, const std::string& why) {
-  (void)wayside->Remove(t.spec.id);
+  for (const WaysideRt& w : waysides) {
+    (void)w.unit->Remove(t.spec.id);
+  }
   channel.Purge(t.spec.id);
   t.phase = Phase::kExited;
   t.exited_ms = now;
@@ -155,6 +160,7 @@ double Simulation::Impl::Move(TrainRt& t, double a, double dt, std::optional<Axl
 // telegram goes to the channel.
 void Simulation::Impl::OnboardCycle(TrainRt& t) {
   std::vector<std::span<const std::uint8_t>> frames(t.inbox.begin(), t.inbox.end());
+  std::vector<std::span<const std::uint8_t>> handover_frames(t.handover_inbox.begin(), t.handover_inbox.end());
   units::OnboardInputs in;
   in.now_ms = now;
   in.sensors = t.next_sensors;
@@ -163,6 +169,7 @@ void Simulation::Impl::OnboardCycle(TrainRt& t) {
   }
   in.balise_id = std::exchange(t.next_balise, std::nullopt);
   in.frames = frames;
+  in.handover_frames = handover_frames;
   in.driver = t.driver;
   if (t.phase == Phase::kDwelling) {
     in.dwell_departure_ms = t.dwell_until_ms;
@@ -174,6 +181,7 @@ void Simulation::Impl::OnboardCycle(TrainRt& t) {
   const auto last_mode = t.unit->Odometry().mode;
   const units::OnboardOutputs& o = t.unit->Cycle(in);
   t.inbox.clear();
+  t.handover_inbox.clear();
   for (const units::RxEvent& e : o.Events()) {
     switch (e.status) {
       case units::RxStatus::kFrameRejected:
@@ -197,7 +205,10 @@ void Simulation::Impl::OnboardCycle(TrainRt& t) {
   if (o.sent) {
     ++t.reports_sent;
     exercised.insert("REQ-MB-001");
-    channel.Send(t.spec.id, Direction::kUplink, now, o.frame.View(), t.radio_blocked);
+    channel.Send(t.spec.id, Direction::kUplink, now, o.frame.View(), t.radio_blocked, o.radio_area);
+  }
+  if (o.handover_sent) {
+    channel.Send(t.spec.id, Direction::kUplink, now, o.handover_frame.View(), t.radio_blocked, *o.handover_area);
   }
   const auto lim = o.authority_limit_mm;
   if (lim && (!before_limit || *lim < *before_limit || o.indications.obstruction != before_kind || Full())) {
@@ -372,11 +383,14 @@ void Simulation::Impl::MoveTrains() {
     const bool refix_due = t.odometry_stopped_ms >= kRefixAfterMs;
     if ((t.was_position_lost && !t.position_lost && t.motion.speed <= 0.0) || refix_due) {
       t.odometry_stopped_ms = 0;
-      (void)wayside->Remove(t.spec.id);
+      for (const WaysideRt& w : waysides) {
+        (void)w.unit->Remove(t.spec.id);
+      }
       channel.Purge(t.spec.id);
-      (void)wayside->Admit(t.spec.id, t.spec.id);
-      const auto st = wayside->Register(mb::wayside::TrainRegistration{t.spec.id, t.length_mm, t.FrontMm(), 0,
-                                                                       mb::wayside::InitialPosition::kEntryBalise});
+      const WaysideRt& w = waysides[WaysideAt(t.FrontMm())];
+      (void)w.unit->Admit(t.spec.id, t.spec.id);
+      const auto st = w.unit->Register(mb::wayside::TrainRegistration{
+          t.spec.id, t.length_mm, t.FrontMm() - w.origin_mm, 0, mb::wayside::InitialPosition::kEntryBalise});
       CreateUnit(t, t.FrontMm());
       Emit(Json{{"ev", "refix"}, {"train", t.spec.id}, {"front_mm", t.FrontMm()},
                 {"status", units::ToString(st.status)}});
@@ -423,7 +437,9 @@ void Simulation::Impl::MoveTrains() {
     // end of the line: standing before the end of track (or a boundary no neighbour
     // accepts) with no stop left, it leaves the area (removed from the wayside unit)
     const auto kind = o.indications.obstruction;
-    const bool at_end = kind == messages::Obstruction::kEndOfTrack || kind == messages::Obstruction::kSystemBoundary;
+    const bool last_unit = o.radio_area + 1 == waysides.size();  // a split's boundary is no line end
+    const bool at_end = kind == messages::Obstruction::kEndOfTrack ||
+                        (kind == messages::Obstruction::kSystemBoundary && last_unit);
     if (t.phase == Phase::kRunning && t.motion.speed <= 0.0 && t.next_stop >= t.spec.stops.size() && at_end &&
         o.indications.limit_mm && ToM(o.indications.target_distance_mm) <= kExitWindowM) {
       t.standing_at_end_ms += sc.step_ms;

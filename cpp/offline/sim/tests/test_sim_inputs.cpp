@@ -136,6 +136,31 @@ TEST(SimGroundLine, BuildsTheGroundConfigurationAndCreatesTheGround) {
   EXPECT_EQ(ground->BlockCount(), 200U);
 }
 
+// A wayside unit of a split line holds its part in its own chainage; an item across an end
+// of the part, or an end off the virtual blocks, names the split.
+TEST(SimGroundLine, TheAreaOfAWaysideUnitIsItsPartOfTheLineShifted) {
+  const Line line = LoadLine(DataDir() / "sim_test_line.json");
+  const RunningLine& up = line.Running("up");
+  const RunningLine a = AreaOfRunningLine(up, 4'000'000, 7'000'000, 6'500'000, "s.json: wayside_splits[0]");
+  EXPECT_EQ(a.length_mm, 3'000'000);
+  ASSERT_EQ(a.blocks_mm.size(), 61U);
+  EXPECT_EQ(a.blocks_mm.front(), 0);
+  EXPECT_EQ(a.blocks_mm.back(), 3'000'000);
+  ASSERT_EQ(a.points.size(), 1U);
+  EXPECT_EQ(a.points[0].section.begin_mm, 1'000'000);
+  EXPECT_EQ(a.routes.size(), 2U);
+  ASSERT_EQ(a.handovers.size(), 1U);
+  EXPECT_EQ(a.handovers[0].position_mm, 2'000'000);
+  EXPECT_TRUE(a.stations.empty());
+  EXPECT_EQ(a.system_boundary_mm, std::optional<std::int64_t>(2'500'000));
+  const GroundLine gl = BuildGroundLine(line, a, mb::wayside::MarginPolicy::kReportedCorrection, 500);
+  EXPECT_NE(CreateGround(line, a, gl, 3), nullptr);
+  testing::ExpectInputError([&] { (void)AreaOfRunningLine(up, 1'900'000, 4'000'000, 3'000'000, "s.json: wayside_splits[0]"); },
+                            "s.json", {"wayside_splits[0]", "the platform of station A", "crosses an end"});
+  testing::ExpectInputError([&] { (void)AreaOfRunningLine(up, 1'925'000, 4'000'000, 3'000'000, "s.json: wayside_splits[0]"); },
+                            "s.json", {"wayside_splits[0]", "virtual-block boundaries"});
+}
+
 // @verifies REQ-MB-020
 TEST(SimGroundLine, ALineTheGroundRefusesNamesTheEntry) {
   nlohmann::json j = TestLineJson();
@@ -221,6 +246,10 @@ TEST(SimScenarioFile, BadScenarioFilesGiveOneLineErrorsNamingTheEntry) {
   ExpectScenarioError([](auto& j) { j["gap"] = {{"leader", 2}, {"follower", 2}, {"from_s", 1}, {"to_s", 2}}; },
                       {"gap.follower", "follower equals leader"});
   ExpectScenarioError([](auto& j) { j["line"] = "../etc/x"; }, {"line", "plain line name"});
+  ExpectScenarioError([](auto& j) { j["wayside_splits"] = {{{"at_m", 4000}, {"overlap_m", 500}}, {{"at_m", 4800}, {"overlap_m", 500}}}; },
+                      {"wayside_splits[1].at_m", "after the previous split's overlap ends"});
+  ExpectScenarioError([](auto& j) { j["wayside_splits"] = {{{"at_m", 4000}, {"overlap_m", 0}}}; },
+                      {"wayside_splits[0].overlap_m"});
   // against the line
   ExpectScenarioError([](auto& j) { j["trains"][0]["stops"] = {{{"station", "Q"}, {"dwell_s", 1}}}; },
                       {"trains[0].stops[0].station", "unknown station 'Q'", "(has: A, B)"}, true);

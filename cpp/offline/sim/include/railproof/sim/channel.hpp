@@ -36,6 +36,7 @@ struct ChannelConfig {
 
 struct Frame {
   std::uint16_t train = 0;  // the train whose link carries it
+  std::size_t wayside = 0;  // the wayside unit at the link's other end (index)
   Direction direction = Direction::kUplink;
   std::int64_t sent_ms = 0;
   std::int64_t due_ms = 0;
@@ -60,7 +61,7 @@ class Channel {
   // from the PRNG, so a fault window does not shift the random sequence of other links.
   // Returns false if the frame was lost.
   bool Send(std::uint16_t train, Direction direction, std::int64_t now_ms, std::span<const std::uint8_t> bytes,
-            bool blocked);
+            bool blocked, std::size_t wayside = 0);
 
   // Frames due at or before now_ms, by due time then send order; removed from the channel.
   std::vector<Frame> Deliver(std::int64_t now_ms);

@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -34,6 +35,14 @@ struct GroundLine {
 // @implements REQ-MB-020
 GroundLine BuildGroundLine(const Line& line, const RunningLine& running, mb::wayside::MarginPolicy policy,
                            std::int64_t ground_cycle_ms);
+
+// The part [begin_mm, end_mm] of a running line that one wayside unit holds, in its own
+// chainage (0 at begin_mm): the virtual blocks, the platforms, no-stop sections, points, routes
+// and radio handovers inside it, and `boundary_mm` (line chainage) as its system boundary.
+// Begin and end must be block boundaries, and no item may cross them: InputError
+// "<scenario>: <where>: <reason>" naming the item.
+RunningLine AreaOfRunningLine(const RunningLine& running, std::int64_t begin_mm, std::int64_t end_mm,
+                              std::optional<std::int64_t> boundary_mm, const std::string& where);
 
 // Capacity for `trains` trains on this line (the defaults, sized down to the line).
 mb::wayside::Capacity GroundCapacity(const GroundLine& gl, std::size_t trains);

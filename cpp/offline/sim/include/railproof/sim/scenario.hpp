@@ -77,6 +77,15 @@ struct GapSpec {
 
 enum class MarginPolicy : std::uint8_t { kReported, kD2 };
 
+// A split of the running line between two wayside units (spec/design/sim.md): the unit before
+// has its system boundary at at_mm and its line runs overlap_mm past it; the next unit's line
+// begins overlap_mm before it (the handover zone).
+struct WaysideSplit {
+  std::int64_t at_mm = 0;
+  std::int64_t overlap_mm = 0;
+  std::string entry;  // "wayside_splits[i]"
+};
+
 // A section of reduced adhesion (wet rail, leaves): the rail's adhesion in [begin, end) is the
 // dry rail's times the wet rail's factor (wet) times `factor`. The trains that run on the
 // wheel-rail vehicle (spec/design/sim.md) feel it; a point-mass train rolls on dry rail.
@@ -104,6 +113,7 @@ struct Scenario {
   std::int64_t sample_ms = 1000;  // diagram / time series resolution
   double handover_secure_ahead_m = 2000.0;  // radio channel secured this far ahead of a train
   bool boundary_accepted = true;            // the neighbour accepts trains at the system boundary
+  std::vector<WaysideSplit> wayside_splits;  // none: one wayside unit runs the whole line
   std::vector<TrainSpec> trains;  // after expanding "repeat"
   std::vector<FaultSpec> faults;
   std::optional<GapSpec> gap;
