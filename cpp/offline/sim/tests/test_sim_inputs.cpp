@@ -14,11 +14,10 @@
 #include "railproof/offline/line.hpp"
 #include "railproof/sim/scenario.hpp"
 #include "railproof/testing/input_error.hpp"
+#include "sim_test_data.hpp"
 
 namespace railproof::sim {
 namespace {
-
-std::filesystem::path DataDir() { return std::filesystem::path(__FILE__).parent_path() / "data"; }
 
 nlohmann::json TestLineJson() {
   std::ifstream in(DataDir() / "sim_test_line.json");

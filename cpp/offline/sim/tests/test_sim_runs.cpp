@@ -17,16 +17,10 @@
 #include "railproof/testing/input_error.hpp"
 #include "railproof/sim/scenario.hpp"
 #include "railproof/sim/simulation.hpp"
+#include "sim_test_data.hpp"
 
 namespace railproof::sim {
 namespace {
-
-std::filesystem::path DataDir() { return std::filesystem::path(__FILE__).parent_path() / "data"; }
-
-const Line& TestLine() {
-  static const Line line = LoadLine(DataDir() / "sim_test_line.json");
-  return line;
-}
 
 // The on-board data of the test's 100 m trains (the form of spec/trains/*.yaml).
 TrainType TestType() {

@@ -18,16 +18,10 @@
 #include "railproof/sim/sensors.hpp"
 #include "railproof/sim/simulation.hpp"
 #include "railproof/sim/wheel_rail_train.hpp"
+#include "sim_test_data.hpp"
 
 namespace railproof::sim {
 namespace {
-
-std::filesystem::path DataDir() { return std::filesystem::path(__FILE__).parent_path() / "data"; }
-
-const Line& TestLine() {
-  static const Line line = LoadLine(DataDir() / "sim_test_line.json");
-  return line;
-}
 
 // One 60 m train (train type test60) at `front_m`, stopping at station A (1990 m) for 20 s
 // and running on; wet rail with leaves (factor 0.4) over [begin_m, 2600) m.

@@ -24,6 +24,7 @@
 #include "railproof/br/supervisor.hpp"
 #include "railproof/testing/jsonl_runner.hpp"
 #include "vector_keys.hpp"
+#include "vector_steps.hpp"
 
 namespace rcli = railproof::conformance;
 

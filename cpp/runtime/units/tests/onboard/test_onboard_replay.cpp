@@ -52,6 +52,7 @@
 #include <vector>
 
 #include "br/conformance/vector_keys.hpp"
+#include "br/conformance/vector_steps.hpp"
 #include "mb/conformance/vector_keys.hpp"
 #include "onboard_rig.hpp"
 #include "ra/conformance/vector_keys.hpp"
