@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -948,6 +949,144 @@ TEST(BrakingPatternsProperty, NeverAboveTheRealPatternAndClose) {
   }
   EXPECT_EQ(compared, 300 * 25 * 2);
   RecordProperty("worst_gap_over_bound", std::to_string(worst_gap));
+}
+
+// A pseudo-random line around the origin for the ordering properties: gradient segments
+// (gaps level), line limits over most of it and temporary restrictions cut into them, sorted
+// and non-overlapping as SetProfile takes them; the limits from walking pace to 35 m/s, many
+// near the speeds the properties draw.
+struct RandomLine {
+  std::vector<GradientSegment> gradients;
+  std::vector<RestrictionSegment> restrictions;
+};
+template <class Uniform>
+RandomLine MakeRandomLine(Uniform& uniform) {
+  RandomLine l;
+  std::int64_t x = uniform(-400'000, 0);
+  for (std::int64_t n = uniform(0, 10); n > 0; --n) {
+    x += uniform(0, 1) * uniform(1, 200'000);
+    const std::int64_t len = uniform(1, 400'000);
+    l.gradients.push_back({x, x + len, uniform(-350, 350)});
+    x += len;
+  }
+  x = uniform(-300'000, 0);
+  for (std::int64_t n = uniform(0, 12); n > 0; --n) {
+    x += uniform(0, 3) == 0 ? uniform(1, 150'000) : 0;  // mostly contiguous, like line limits
+    const std::int64_t len = uniform(0, 1) == 0 ? uniform(1'000, 80'000) : uniform(1, 400'000);
+    l.restrictions.push_back({x, x + len, uniform(0, 1) == 0 ? uniform(1'000, 12'000) : uniform(1'000, 35'000)});
+    x += len;
+  }
+  return l;
+}
+
+// The emergency pattern is never below the service pattern at the supervised front (v_e >=
+// v_7n), on pseudo-random lines, positions, errors, speeds and stop limits, for the train types
+// and for train data drawn under the design rule (beta_n7 <= beta_e) with the emergency
+// free-running time not above the service one (as every train type of spec/trains has it; Create
+// does not require it, and with a longer emergency free-running time v_e < v_7n does occur): the
+// emergency pattern brakes at least as hard, runs up for no longer (so no faster and no
+// farther), targets the stop limit itself rather than service_offset short of it and each
+// restriction at its limit plus the overspeed allowance. So a concrete state never has v_s
+// above v_e and not above v_7n (the br vectors that ask for it are not replayed through the
+// on-board unit: units/tests/onboard/test_onboard_replay.cpp).
+// @verifies REQ-BR-010
+TEST(BrakingPatternsProperty, EmergencyNeverBelowService) {
+  std::mt19937_64 rng(20261127);
+  auto uniform = [&](std::int64_t lo, std::int64_t hi) {
+    return lo + static_cast<std::int64_t>(rng() % static_cast<std::uint64_t>(hi - lo + 1));
+  };
+  int compared = 0;
+  int service_exceeded_alone = 0;  // v_s between v_7n and v_e: both patterns met
+  for (int profile = 0; profile < 400; ++profile) {
+    TrainData t = std::array<TrainData, 3>{Emu3(), Dmu2(), Emu10()}[static_cast<std::size_t>(profile % 4 % 3)];
+    if (profile % 4 == 3) {
+      t.beta_e_mm_s2 = uniform(500, 1'500);
+      t.beta_n7_mm_s2 = uniform(300, t.beta_e_mm_s2);
+      t.service_free_running_ms = uniform(500, 4'000);
+      t.emergency_free_running_ms = uniform(0, t.service_free_running_ms);
+      t.accel_max_mm_s2 = uniform(0, 1'500);
+      t.overspeed_mm_s = uniform(0, 3'000);
+    }
+    const RandomLine l = MakeRandomLine(uniform);
+    PatternCalculator c = Make(t);
+    if (c.SetProfile(l.gradients, l.restrictions).verdict != ProfileVerdict::kAccept) {
+      continue;  // a falling gradient steeper than the drawn braking: no profile to supervise
+    }
+    for (int k = 0; k < 40; ++k) {
+      const PositionEstimate pos{uniform(-300'000, 1'500'000), uniform(0, 30'000), uniform(0, 30'000),
+                                 uniform(0, 35'000), false};
+      const Evaluation e = c.Evaluate(pos, pos.front_mm + uniform(-10'000, 1'500'000));
+      ASSERT_EQ(e.status, EvalStatus::kOk);
+      ASSERT_GE(e.speeds.v_e, e.speeds.v_7n) << profile << " " << k << " front " << pos.front_mm;
+      service_exceeded_alone += e.speeds.v_s > e.speeds.v_7n && e.speeds.v_s <= e.speeds.v_e ? 1 : 0;
+      ++compared;
+    }
+  }
+  EXPECT_GT(compared, 10'000);
+  EXPECT_GT(service_exceeded_alone, 100);
+}
+
+// Of the service pattern's five points (x_s and the 6N, 5N, 4N and release leads) the ones v_s
+// exceeds form a prefix and a suffix, never a run with a point not exceeded on either side,
+// wherever the five lie within the ceiling extension (length + front error + rear error) and
+// share one run-up acceleration. Between y1 < y2 < y3: the stop limit or a restriction ahead
+// that is exceeded at y2 is exceeded at y3 (nearer, or a ceiling by then); a restriction's
+// ceiling exceeded at y2 but not at y1 is not reached at y1 (begin beyond y1's run-up), and not
+// at y3 only once y3 has passed end + extension, farther than the extension from y1. So the br
+// vectors that ask for such a run have no concrete state at a speed whose release lead is
+// shorter than the train (units/tests/onboard/test_onboard_replay.cpp: 5 m/s, 26.5 m against
+// 60 m).
+// @verifies REQ-BR-004
+TEST(BrakingPatternsProperty, NoExceededRunBetweenLeadsWithinTheCeilingExtension) {
+  std::mt19937_64 rng(20261128);
+  auto uniform = [&](std::int64_t lo, std::int64_t hi) {
+    return lo + static_cast<std::int64_t>(rng() % static_cast<std::uint64_t>(hi - lo + 1));
+  };
+  const SupervisionParams s = DefaultSupervisionParams();
+  const std::array<std::int64_t, 5> leads{0, s.lead_6n_ms, s.lead_5n_ms, s.lead_4n_ms, s.release_lead_ms};
+  int checked = 0;
+  int prefix_and_suffix = 0;  // exceeded at x_s and at the release lead, not between
+  int prefix_alone = 0;       // exceeded at x_s, not at the release lead
+  for (int profile = 0; profile < 400; ++profile) {
+    const TrainData t = std::array<TrainData, 3>{Emu3(), Dmu2(), Emu10()}[static_cast<std::size_t>(profile % 3)];
+    const RandomLine l = MakeRandomLine(uniform);
+    PatternCalculator c = Make(t);
+    if (c.SetProfile(l.gradients, l.restrictions).verdict != ProfileVerdict::kAccept) {
+      continue;
+    }
+    for (int k = 0; k < 100; ++k) {
+      const PositionEstimate pos{uniform(-300'000, 1'500'000), uniform(0, 20'000), uniform(0, 20'000),
+                                 uniform(0, 12'000), false};
+      const Evaluation e = c.Evaluate(pos, pos.front_mm + uniform(0, 1'500'000));
+      ASSERT_EQ(e.status, EvalStatus::kOk);
+      const std::int64_t x_s = pos.front_mm + pos.front_error_mm;
+      const std::int64_t envelope = pos.front_error_mm + pos.rear_error_mm;
+      std::array<std::int64_t, 5> points{};
+      std::transform(leads.begin(), leads.end(), points.begin(),
+                     [&](std::int64_t lead) { return x_s + (e.speeds.v_s * lead + 999) / 1'000; });
+      const bool one_run_up = std::all_of(points.begin(), points.end(), [&](std::int64_t y) {
+        return c.RunUpAcceleration(Pattern::kService, y, envelope) ==
+               c.RunUpAcceleration(Pattern::kService, x_s, envelope);
+      });
+      if (points[4] - x_s >= t.length_mm + envelope || !one_run_up) {
+        continue;
+      }
+      const std::array<bool, 5> ex{e.speeds.v_s > e.speeds.v_7n, e.speeds.v_s > e.speeds.v_6n,
+                                   e.speeds.v_s > e.speeds.v_5n, e.speeds.v_s > e.speeds.v_4n,
+                                   e.speeds.v_s > e.speeds.v_release};
+      // no exceeded point between the first and the last point not exceeded
+      const auto first_clear = std::find(ex.begin(), ex.end(), false);
+      const auto last_clear = std::find(ex.rbegin(), ex.rend(), false).base();
+      ASSERT_TRUE(first_clear == ex.end() || std::find(first_clear, last_clear, true) == last_clear)
+          << profile << " " << k << " front " << pos.front_mm;
+      prefix_and_suffix += ex[0] && ex[4] && std::count(ex.begin(), ex.end(), false) > 0 ? 1 : 0;
+      prefix_alone += ex[0] && !ex[4] ? 1 : 0;
+      ++checked;
+    }
+  }
+  EXPECT_GT(checked, 30'000);
+  EXPECT_GT(prefix_and_suffix, 10);
+  EXPECT_GT(prefix_alone, 100);
 }
 
 // The scenario of bench_braking (REQ-BR-013: 5 km look-ahead, 30 gradient changes and 20
