@@ -153,6 +153,43 @@ struct Shift {
   }
 };
 
+// A crossing of the vector as the unit holds it: its output of the cycle and its controller's
+// state, or a failure naming it.
+struct HeldCrossing {
+  const CrossingOutput* output = nullptr;
+  const lc::wayside::ControllerStatus* status = nullptr;
+};
+HeldCrossing Held(const WaysideUnit& unit, const CycleOutput& out, std::uint32_t id, const std::string& pre,
+                  rc::Checker& chk) {
+  const auto o = std::find_if(out.crossings.begin(), out.crossings.end(),
+                              [&](const CrossingOutput& x) { return x.crossing_id == id; });
+  const lc::wayside::CrossingController* ctl = unit.Controller(id);
+  if (o == out.crossings.end() || ctl == nullptr) {
+    chk.Fail(pre + "not held by the unit");
+    return {};
+  }
+  return {&*o, &ctl->Status()};
+}
+
+// What both variants compare of a crossing: the equipment commands and the alarm, the report,
+// the controller's state, warning start and failure (times in the model's clock).
+void ExpectCrossing(const std::string& pre, const json& e, const HeldCrossing& x, const Shift& shift,
+                    rc::Checker& chk) {
+  const CrossingOutput& o = *x.output;
+  const lc::wayside::ControllerStatus& st = *x.status;
+  chk.Expect(pre + "lights_on", rc::Bool(e.at("lights_on").get<bool>()), rc::Bool(o.lights_on));
+  chk.Expect(pre + "barriers_down_commanded", rc::Bool(e.at("barriers_down_commanded").get<bool>()),
+             rc::Bool(o.barriers_down_commanded));
+  chk.Expect(pre + "alarm", "false", rc::Bool(o.alarm));
+  chk.Expect(pre + "report", ReportString(e.at("report")), ReportString(shift.ToModel(o.report)));
+  chk.Expect(pre + "state", e.at("state").get<std::string>(), lc::wayside::ToString(st.state));
+  if (!e.at("warning_start_ms").is_null()) {
+    chk.Expect(pre + "warning_start_ms", rc::OptInt(e.at("warning_start_ms")),
+               std::to_string(shift.ToModel(st.warning_start_ms)));
+  }
+  chk.Expect(pre + "failure", e.at("failure").get<std::string>(), lc::wayside::ToString(st.failure));
+}
+
 bool Lists(const json& ids, std::uint32_t train) {
   return std::any_of(ids.begin(), ids.end(), [&](const json& x) { return x.get<std::uint32_t>() == train; });
 }
@@ -284,25 +321,12 @@ void ReplayLc(const LcFile& f, const rc::JsonVector& v, std::vector<std::string>
       const json& e = controllers[i].at("out");
       const auto id = controllers[i].at("crossing_id").get<std::uint32_t>();
       const std::string pre = "crossing " + std::to_string(id) + " ";
-      const auto o = std::find_if(out.crossings.begin(), out.crossings.end(),
-                                  [&](const CrossingOutput& x) { return x.crossing_id == id; });
-      const lc::wayside::CrossingController* ctl = unit.Controller(id);
-      if (o == out.crossings.end() || ctl == nullptr) {
-        chk.Fail(pre + "not held by the unit");
+      const HeldCrossing held = Held(unit, out, id, pre, chk);
+      if (held.output == nullptr) {
         continue;
       }
-      chk.Expect(pre + "lights_on", rc::Bool(e.at("lights_on").get<bool>()), rc::Bool(o->lights_on));
-      chk.Expect(pre + "barriers_down_commanded", rc::Bool(e.at("barriers_down_commanded").get<bool>()),
-                 rc::Bool(o->barriers_down_commanded));
-      chk.Expect(pre + "alarm", "false", rc::Bool(o->alarm));
-      chk.Expect(pre + "report", ReportString(e.at("report")), ReportString(shift.ToModel(o->report)));
-      chk.Expect(pre + "state", e.at("state").get<std::string>(), lc::wayside::ToString(ctl->Status().state));
-      if (!e.at("warning_start_ms").is_null()) {
-        chk.Expect(pre + "warning_start_ms", rc::OptInt(e.at("warning_start_ms")),
-                   std::to_string(shift.ToModel(ctl->Status().warning_start_ms)));
-      }
-      chk.Expect(pre + "failure", e.at("failure").get<std::string>(), lc::wayside::ToString(ctl->Status().failure));
-      chk.Expect(pre + "requesters", Ids(e.at("requesters")), Ids(ctl->Status().Requesters()));
+      ExpectCrossing(pre, e, held, shift, chk);
+      chk.Expect(pre + "requesters", Ids(e.at("requesters")), Ids(held.status->Requesters()));
       for (const Train& t : trains) {
         const std::string tpre = pre + "to train " + std::to_string(t.id) + ": ";
         std::string report = "none";
@@ -416,24 +440,12 @@ void CheckCrossings(const WaysideUnit& unit, const CycleOutput& out, const json&
     const json& e = x.at("out");
     const auto id = x.at("crossing_id").get<std::uint32_t>();
     const std::string pre = "crossing " + std::to_string(id) + " ";
-    const auto o = std::find_if(out.crossings.begin(), out.crossings.end(),
-                                [&](const CrossingOutput& c) { return c.crossing_id == id; });
-    const lc::wayside::CrossingController* ctl = unit.Controller(id);
-    if (o == out.crossings.end() || ctl == nullptr) {
-      chk.Fail(pre + "not held by the unit");
+    const HeldCrossing held = Held(unit, out, id, pre, chk);
+    if (held.output == nullptr) {
       continue;
     }
-    const lc::wayside::ControllerStatus& st = ctl->Status();
-    chk.Expect(pre + "state", e.at("state").get<std::string>(), lc::wayside::ToString(st.state));
-    if (!e.at("warning_start_ms").is_null()) {
-      chk.Expect(pre + "warning_start_ms", rc::OptInt(e.at("warning_start_ms")), std::to_string(st.warning_start_ms));
-    }
-    chk.Expect(pre + "report", ReportString(e.at("report")), ReportString(o->report));
-    chk.Expect(pre + "lights_on", rc::Bool(e.at("lights_on").get<bool>()), rc::Bool(o->lights_on));
-    chk.Expect(pre + "barriers_down_commanded", rc::Bool(e.at("barriers_down_commanded").get<bool>()),
-               rc::Bool(o->barriers_down_commanded));
-    chk.Expect(pre + "alarm", "false", rc::Bool(o->alarm));
-    chk.Expect(pre + "failure", e.at("failure").get<std::string>(), lc::wayside::ToString(st.failure));
+    ExpectCrossing(pre, e, held, Shift{}, chk);  // the GNSS-time replay runs in the model's clock
+    const lc::wayside::ControllerStatus& st = *held.status;
     std::vector<lc::wayside::StartTimeAck> start_acks;
     std::copy_if(out.start_acks.begin(), out.start_acks.end(), std::back_inserter(start_acks),
                  [&](const lc::wayside::StartTimeAck& a) { return a.crossing_id == id; });
