@@ -31,7 +31,19 @@
  * unbounded runs.
  *
  * Configurations (-D): default = verification and trap goals (TRAPS adds the goal flags);
- * WALK stops after MODEL_CYCLES cycles (random-walk vectors).
+ * WALK stops after MODEL_CYCLES cycles (random-walk vectors). REALISABLE = the on-board
+ * unit's environment: only the relations between v_s and the pattern speeds that the
+ * braking module's pattern calculator can give at the unit's external interface (design note
+ * spec/design/units.md, shown on the calculator by the property tests
+ * BrakingPatternsProperty.EmergencyNeverBelowService and
+ * .NoExceededRunBetweenLeadsWithinTheCeilingExtension): the emergency pattern exceeded only
+ * with the service pattern exceeded (v_e >= v_7n), and of the five service points x_s (7N),
+ * the 6N, 5N, 4N and release leads, the ones v_s exceeds form a prefix (a restriction's
+ * ceiling released between two lead points) and a suffix (the stop limit or a restriction
+ * ahead): the points not exceeded are one contiguous run. A variant (@variant below): every
+ * property is verified there too (the environment never blocks a cycle), every goal is
+ * searched again, and its goal and random-walk vectors are br.unit.jsonl, each of which the
+ * unit-level replay drives through the on-board unit.
  *
  * Annotations read by testgen: see models/tg.pml.
  */
@@ -65,6 +77,12 @@ byte prev;
 #ifdef WALK
 byte ncycles;
 #endif
+#ifdef REALISABLE
+/* ---- scratch of the unit's environment (cleared at the end of the cycle) --------------- */
+bit must;             /* the next pattern speed picked must be exceeded by v_s */
+byte phase;           /* service points so far: 0 all exceeded, 1 a run not exceeded began,
+                       * 2 exceeded again after it (the rest must be exceeded) */
+#endif
 /* ---- ghost: latched property violations ----------------------------------------------- */
 bit v_eb, v_latch, v_service, v_mild, v_release, v_ind;
 #ifdef TRAPS
@@ -80,6 +98,7 @@ byte h_i;
 #endif
 
 /* one speed, any value 0..VMAX, each a single transition (uniform in random walks) */
+#ifndef REALISABLE
 #define CHOOSE(x) \
   if \
   :: x = 0 :: x = 1 \
@@ -87,7 +106,21 @@ byte h_i;
   :: (VMAX >= 5) -> x = 5 :: (VMAX >= 6) -> x = 6 :: (VMAX >= 7) -> x = 7 \
   :: (VMAX >= 8) -> x = 8 :: (VMAX >= 9) -> x = 9 \
   fi
+#endif
 #define CHOOSE_BIT(b) if :: b = 0 :: b = 1 fi
+#ifdef REALISABLE
+/* one speed as CHOOSE, restricted to values v_s exceeds while `must` is set (never empty:
+ * `must` follows an exceeded pattern speed, so v_s >= 1 and 0 is always allowed) */
+#define OK_M(k) (!must || vs > (k))
+#define CHOOSE(x) \
+  if \
+  :: OK_M(0) -> x = 0 :: OK_M(1) -> x = 1 \
+  :: (VMAX >= 2 && OK_M(2)) -> x = 2 :: (VMAX >= 3 && OK_M(3)) -> x = 3 \
+  :: (VMAX >= 4 && OK_M(4)) -> x = 4 :: (VMAX >= 5 && OK_M(5)) -> x = 5 \
+  :: (VMAX >= 6 && OK_M(6)) -> x = 6 :: (VMAX >= 7 && OK_M(7)) -> x = 7 \
+  :: (VMAX >= 8 && OK_M(8)) -> x = 8 :: (VMAX >= 9 && OK_M(9)) -> x = 9 \
+  fi
+#endif
 
 #define RELEASE_ALL (st && he && rs)
 /* step 1: the conditions that release a latched emergency brake (REQ-BR-006) */
@@ -259,6 +292,9 @@ inline goals() {
 inline clear_cycle() {
   vs = 0; ve = 0; v7 = 0; v6 = 0; v5 = 0; v4 = 0; vr = 0; st = 0; he = 0; rs = 0;
   level = 0; appr = 0; was_latched = 0; prev = 0
+#ifdef REALISABLE
+  ; must = 0; phase = 0
+#endif
 }
 
 /* A pattern speed x, once printed, is kept only as its relation to v_s, all that the
@@ -268,7 +304,20 @@ inline clear_cycle() {
  * on it as on the chosen value. This keeps the breadth-first search (which stores the
  * states inside the atomic cycle) small without losing any input. */
 #define CANON(x) if :: x + 1 < vs -> x = vs - 2 :: x > vs -> x = vs + 1 :: else -> skip fi
-#define PICK(x, k) CHOOSE(x); d_step { printf("@IN p%d=%d\n", k, x); CANON(x) }
+#ifdef REALISABLE
+/* REALISABLE: v_e exceeded makes v_7n's pick `must`; each service point then moves the phase
+ * (exceeded, a run not exceeded, exceeded again), and phase 2 makes the rest `must` */
+#define SHAPE(x, k) \
+  if \
+  :: k == 0 -> must = (vs > x) \
+  :: k > 0 && phase == 0 && !(vs > x) -> phase = 1; must = 0 \
+  :: k > 0 && phase == 1 && vs > x -> phase = 2; must = 1 \
+  :: else -> must = (phase == 2) \
+  fi
+#else
+#define SHAPE(x, k) skip
+#endif
+#define PICK(x, k) CHOOSE(x); d_step { printf("@IN p%d=%d\n", k, x); CANON(x); SHAPE(x, k) }
 
 init {
   do
@@ -312,6 +361,7 @@ ltl REQ_BR_003_release { [] !v_release }
 // @property REQ_BR_003_indication REQ-BR-003 : "pattern approaching" is shown exactly when the supervised speed exceeds the release-lead pattern speed or a brake is commanded
 ltl REQ_BR_003_indication { [] !v_ind }
 
+// @variant REALISABLE : the on-board unit's environment: only the relations between v_s and the pattern speeds the braking module's pattern calculator can give (v_e >= v_7n; the service points v_s exceeds are a prefix and a suffix); every property is verified there too, every goal searched again, and its vectors (br.unit.jsonl) are each replayed through the on-board unit
 // @mutant MUTANT_RESET_IGNORES_HANDLE violates REQ_BR_006_latch : the latch is released at standstill with reset, whatever the brake handle (C++ FAULT_BR_RESET_IGNORES_HANDLE)
 // @mutant MUTANT_RELEASE_WHILE_MOVING violates REQ_BR_006_latch : the latch is released with handle and reset without standstill (C++ FAULT_BR_RELEASE_WHILE_MOVING)
 // @mutant MUTANT_NO_RELEASE_LEAD violates REQ_BR_003_release : an applied service brake is released as soon as no lead is reached (C++ FAULT_BR_NO_RELEASE_LEAD)

@@ -35,7 +35,8 @@
  *   // @assert <label> <REQ ids> : text     (on the line before an assert(...))
  *   // @variant <DEFINE> <param>=<model bound> : text   (a boundary variant: every default
  *      property is verified in it too, and it supplies vectors for goals unreachable in
- *      the main configuration; the vector header carries the overridden parameter)
+ *      the main configuration; the vector header carries the overridden parameter; without
+ *      <param>=<bound> an environment variant, e.g. models/br.pml REALISABLE)
  */
 #include "tg_params.pml"
 

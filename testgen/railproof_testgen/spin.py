@@ -52,7 +52,7 @@ _PROP = _annotation("property", rf"(\w+)\s+{_REQS}:\s*(.*)")
 _GOAL = _annotation("goal", rf"(\d+)\s+{_REQS}:\s*(.*)")
 _MUT = _annotation("mutant", r"(\w+)\s+violates\s+(\S+)\s*:\s*(.*)")
 _ASSERT = _annotation("assert", rf"(\w+)\s+{_REQS}:\s*(.*)")
-_VARIANT = _annotation("variant", r"(\w+)\s+(\w+)=(\w+)\s*:\s*(.*)")
+_VARIANT = _annotation("variant", r"(\w+)(?:\s+(\w+)=(\w+))?\s*:\s*(.*)")
 _CONFIG = re.compile(r"\[config\s+(\w+(?:\s+\w+)*)\]")
 _PAN_FLAGS = _annotation("pan_flags", r"((?:-D\w+(?:=\w+)?\s*)+)")
 
@@ -105,8 +105,8 @@ class Mutant:
 @dataclass
 class Variant:
     define: str
-    parameter: str  # vector header parameter it overrides
-    bound: str      # model bound (lower-case name without MODEL_) giving the new value
+    parameter: str | None  # vector header parameter it overrides (None: an environment variant)
+    bound: str | None      # model bound (lower-case name without MODEL_) giving the new value
     text: str
 
 

@@ -79,7 +79,8 @@ def test_header_records_units_and_bounds():
 def test_vectors_are_consistent_and_hit_every_boundary():
     vs = vector_set("br")
     vecs = vs.vectors("br.jsonl")
-    assert set(vs.files) == {"br.jsonl"} and vs.coverage["reached"] == vs.coverage["labelled"]  # every branch
+    assert set(vs.files) == {"br.jsonl", "br.unit.jsonl"}
+    assert vs.coverage["reached"] == vs.coverage["labelled"]  # every branch
     vmax = vs.header("br.jsonl")["parameters"]["model_vmax"]
     cycles = vs.header("br.jsonl")["parameters"]["model_cycles"]
     assert all(len(v["steps"]) == cycles for v in vecs if v["kind"] == "random")
@@ -100,3 +101,29 @@ def test_vectors_are_consistent_and_hit_every_boundary():
     held = [s["in"] for v in vecs if v["goal"] in ("G0", "G1", "G2") for s in v["steps"][-1:]]
     assert sorted((i["standstill"], i["handle_emergency"], i["reset"]) for i in held) == [
         (False, True, True), (True, False, True), (True, True, False)]
+
+
+def _exceeded(i):
+    return [i["v_s"] > i[p] for p in br.PATTERNS]
+
+
+def test_unit_vectors_stay_in_the_units_environment():
+    """br.unit.jsonl (variant REALISABLE): in every step v_e is exceeded only with v_7n, and the
+    service points v_s does not exceed are one contiguous run (the rest a prefix and a suffix);
+    every goal but G21 (EB with the service pattern not exceeded) has a vector there."""
+    vs = vector_set("br")
+    vecs = vs.vectors("br.unit.jsonl")
+    assert vs.header("br.unit.jsonl")["configuration"] == "REALISABLE"
+    assert all(v["id"].startswith("BR-") and "-UNIT-" in v["id"] for v in vecs)
+    for v in vecs:
+        for s in v["steps"]:
+            e = _exceeded(s["in"])
+            assert not e[0] or e[1], (v["id"], s["in"])
+            service = "".join("1" if x else "0" for x in e[1:])
+            assert "1" not in service.strip("1"), (v["id"], s["in"])  # 1..1 0..0 1..1
+    goals = {v["goal"] for v in vecs if v["goal"]}
+    assert goals == {f"G{k}" for k in range(24)} - {"G21"}
+    assert sum(v["kind"] == "random" for v in vecs) == 50
+    # the default file keeps the unordered relations the unit cannot give (module replay only)
+    default = [s["in"] for v in vs.vectors("br.jsonl") for s in v["steps"]]
+    assert any(e[0] and not e[1] for e in map(_exceeded, default))

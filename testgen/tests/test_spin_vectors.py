@@ -36,6 +36,15 @@ def test_annotations_of_the_fixture():
     assert [(v.define, v.parameter, v.bound) for v in ann.variants] == [("WIDE", "limit", "wide_limit")]
 
 
+def test_environment_variant_without_a_parameter(tmp_path):
+    m = tmp_path / "m.pml"
+    m.write_text("// @property P REQ-TG-001 : p\nltl P { [] true }\n"
+                 "// @variant NARROW : a narrower environment\n// @variant WIDE limit=wide_limit : wider\n")
+    ann = spin.parse_annotations(m)
+    assert [(v.define, v.parameter, v.bound, v.text) for v in ann.variants] == [
+        ("NARROW", None, None, "a narrower environment"), ("WIDE", "limit", "wide_limit", "wider")]
+
+
 def test_mutant_naming_an_unknown_property_is_rejected(tmp_path):
     m = tmp_path / "m.pml"
     m.write_text("// @property P REQ-TG-001 : p\nltl P { [] true }\n// @mutant MX violates Q : q\n")

@@ -1,12 +1,14 @@
 """The braking part of vector generation: the supervision decision of models/br.pml
 (spec/design/br.md §4: brake-level selection, emergency-brake latch and release); the engine
 is vectors.py. Goals whose label names a boundary give the boundary vectors (v_s exactly at
-and one above a pattern speed); random walks of MODEL_CYCLES cycles (configuration WALK).
+and one above a pattern speed); random walks of MODEL_CYCLES cycles (configuration WALK), in
+the model's default configuration (br.jsonl) and in REALISABLE, the on-board unit's
+environment (br.unit.jsonl).
 
 Units: the model's speeds are abstract integers 0..MODEL_VMAX; the vectors carry them
 unchanged and the conformance harness feeds them to br::Supervisor as mm/s. This is exact
 because the decision only compares the supervised speed with the pattern speeds (header
-"units"). One file, br.jsonl (schema spec/schemas/vectors_br.schema.json).
+"units"). Two files, br.jsonl and br.unit.jsonl (schema spec/schemas/vectors_br.schema.json).
 """
 from __future__ import annotations
 
@@ -34,7 +36,10 @@ _RX = {
 
 class Braking(Part):
     prefix = "BR"
-    configurations = (Configuration(None, walks=1),)
+    # REALISABLE: the on-board unit's environment (models/br.pml); its walks are br.unit.jsonl,
+    # the vectors the unit-level replay drives through the on-board unit
+    configurations = (Configuration(None, walks=1),
+                      Configuration("REALISABLE", suffix=".unit", tag="UNIT-", walks=1))
     walk_events = "cycles"
 
     def bounds(self, model, params_pml):
@@ -83,7 +88,7 @@ class Braking(Part):
 
     def header(self, target, define):
         b = target.bounds
-        return target.header(configuration="default", units=UNITS, unit_scales={"speed_mm_s_per_unit": 1},
+        return target.header(configuration=self.configuration(define).name, units=UNITS, unit_scales={"speed_mm_s_per_unit": 1},
                              parameters={"model_vmax": b["vmax"], "model_cycles": b["cycles"], "levels": LEVELS})
 
 

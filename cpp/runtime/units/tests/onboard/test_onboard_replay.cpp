@@ -28,8 +28,10 @@
 //       1.4 m/s) per sensor cycle, the deviation false where both agree: a per-vector search
 //       over wheel-slip and IMU streams, not written. The ra runner replays them module by
 //       module.
-//   br  the vectors whose every step has a concrete state (41 of 74, 10 of them with a speed
-//       restriction): a step's abstract speeds count only as the set of pattern speeds v_s
+//   br  every vector of br.unit.jsonl (73, the variant REALISABLE of models/br.pml: the
+//       relations between v_s and the pattern speeds the unit's calculator can give), and the
+//       vectors of br.jsonl whose every step has a concrete state (41 of 74, 10 of them with a
+//       speed restriction): a step's abstract speeds count only as the set of pattern speeds v_s
 //       exceeds (the decision compares nothing else; the model's equalities and "one above"
 //       are not kept). The rig's train stands or runs at 5 m/s; each supervision's stop limit
 //       and one restriction, answered to the telegram before it, are chosen with the braking
@@ -39,8 +41,9 @@
 //       after the cycle with the unit's own envelope, profile and speed). The next telegram
 //       withdraws the restriction. Starts and stops between a standing and a running step take
 //       supervisions of their own, which change nothing the next step reads. Out: the level,
-//       "pattern approaching" and the brake demand. The other 33 ask for what real pattern
-//       speeds never give (the model draws each independently), shown on the pattern
+//       "pattern approaching" and the brake demand. The other 33 of br.jsonl ask for what real
+//       pattern speeds never give (the default configuration draws each independently; the
+//       variant excludes exactly these), shown on the pattern
 //       calculator in br/tests/test_patterns.cpp: 11 v_e below v_7n
 //       (EmergencyNeverBelowService), 22 a run of exceeded points with one not exceeded on
 //       either side among x_s and the 6N, 5N, 4N and release leads, which at 5 m/s lie within
@@ -718,11 +721,12 @@ void ReplayBr(const json& steps, std::vector<std::string>& problems) {
 
 TEST(OnboardReplay, BrakingVectorsWithConcretePatterns) {
   const Loaded l = Load("br", rc::BrVectorKeys());
-  std::size_t replayed = 0;
-  std::size_t with_restrictions = 0;
-  std::map<BrGap, std::size_t> gaps;
+  std::map<std::string, std::size_t> replayed;           // per file
+  std::map<std::string, std::size_t> with_restrictions;  // per file
+  std::map<BrGap, std::size_t> gaps;                     // br.jsonl only
   for (const auto& [file, v] : l.vectors) {
     const json& steps = v.at("steps");
+    const bool unit_set = l.headers.at(file).at("configuration").get<std::string>() == "REALISABLE";
     BrGap gap = BrGap::kNone;
     bool restricted = false;
     for (std::size_t k = 0; k < steps.size() && gap == BrGap::kNone; ++k) {
@@ -731,6 +735,9 @@ TEST(OnboardReplay, BrakingVectorsWithConcretePatterns) {
       restricted = restricted || s.prefix > 0;
     }
     if (gap != BrGap::kNone) {
+      // the unit's environment (models/br.pml, REALISABLE) gives concrete states only
+      EXPECT_FALSE(unit_set) << file << ": " << v.at("id").get<std::string>()
+                             << ": a step the on-board unit's pattern calculator cannot give";
       ++gaps[gap];
       continue;
     }
@@ -740,19 +747,29 @@ TEST(OnboardReplay, BrakingVectorsWithConcretePatterns) {
     for (const std::string& p : problems) {
       ADD_FAILURE() << p;
     }
-    ++replayed;
-    with_restrictions += restricted ? 1 : 0;
+    ++replayed[file];
+    with_restrictions[file] += restricted ? 1 : 0;
   }
-  // The vector set of models/br.pml: every boundary vector, the trap vectors but G21 (EB with
-  // v_s not above v_7n), and 18 of the 50 random walks, whose pattern speeds are drawn
-  // independently; G22 (7N with v_s not above v_6n) and 9 of those walks with a restriction.
-  // Not replayed (a vector counted at its first step without a concrete state): G21 and 10
-  // walks with v_e below v_7n, 22 walks with a run of exceeded points between lead points.
-  EXPECT_EQ(replayed, 41U);
-  EXPECT_EQ(with_restrictions, 10U);
+  // br.jsonl, the model's default configuration (every relation between the speeds): every
+  // boundary vector, the trap vectors but G21 (EB with v_s not above v_7n), and 18 of the 50
+  // random walks, whose pattern speeds are drawn independently; G22 (7N with v_s not above
+  // v_6n) and 9 of those walks with a restriction. Not replayed (a vector counted at its first
+  // step without a concrete state): G21 and 10 walks with v_e below v_7n, 22 walks with a run
+  // of exceeded points between lead points. They are replayed module by module (the br
+  // runner), which the unit's external interface cannot reach.
+  EXPECT_EQ(replayed["br.jsonl"], 41U);
+  EXPECT_EQ(with_restrictions["br.jsonl"], 10U);
   EXPECT_EQ(gaps[BrGap::kEmergencyBelowService], 11U);
   EXPECT_EQ(gaps[BrGap::kRunBetweenLeads], 22U);
-  RecordProperty("replayed", std::to_string(replayed));
+  // br.unit.jsonl, the variant REALISABLE (the unit's environment): every vector, i.e. the 23
+  // goals reachable there (all but G21) and 50 random walks.
+  const std::size_t unit_vectors = l.headers.at("br.unit.jsonl").at("vector_count").get<std::size_t>();
+  EXPECT_EQ(unit_vectors, 73U);
+  EXPECT_EQ(replayed["br.unit.jsonl"], unit_vectors);
+  EXPECT_GT(with_restrictions["br.unit.jsonl"], 0U);
+  RecordProperty("replayed", std::to_string(replayed["br.jsonl"] + replayed["br.unit.jsonl"]));
+  RecordProperty("replayed_unit_set", std::to_string(replayed["br.unit.jsonl"]));
+  RecordProperty("with_restrictions_unit_set", std::to_string(with_restrictions["br.unit.jsonl"]));
 }
 
 }  // namespace
