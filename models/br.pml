@@ -97,30 +97,23 @@ byte h_i;
 #define GOAL(k) skip
 #endif
 
-/* one speed, any value 0..VMAX, each a single transition (uniform in random walks) */
-#ifndef REALISABLE
-#define CHOOSE(x) \
-  if \
-  :: x = 0 :: x = 1 \
-  :: (VMAX >= 2) -> x = 2 :: (VMAX >= 3) -> x = 3 :: (VMAX >= 4) -> x = 4 \
-  :: (VMAX >= 5) -> x = 5 :: (VMAX >= 6) -> x = 6 :: (VMAX >= 7) -> x = 7 \
-  :: (VMAX >= 8) -> x = 8 :: (VMAX >= 9) -> x = 9 \
-  fi
-#endif
-#define CHOOSE_BIT(b) if :: b = 0 :: b = 1 fi
+/* one speed, any value 0..VMAX, each a single transition (uniform in random walks);
+ * REALISABLE: only values v_s exceeds while `must` is set (never empty: `must` follows an
+ * exceeded pattern speed, so v_s >= 1 and 0 is always allowed) */
 #ifdef REALISABLE
-/* one speed as CHOOSE, restricted to values v_s exceeds while `must` is set (never empty:
- * `must` follows an exceeded pattern speed, so v_s >= 1 and 0 is always allowed) */
-#define OK_M(k) (!must || vs > (k))
+#define AND_OK(k) && (!must || vs > (k))
+#else
+#define AND_OK(k)
+#endif
 #define CHOOSE(x) \
   if \
-  :: OK_M(0) -> x = 0 :: OK_M(1) -> x = 1 \
-  :: (VMAX >= 2 && OK_M(2)) -> x = 2 :: (VMAX >= 3 && OK_M(3)) -> x = 3 \
-  :: (VMAX >= 4 && OK_M(4)) -> x = 4 :: (VMAX >= 5 && OK_M(5)) -> x = 5 \
-  :: (VMAX >= 6 && OK_M(6)) -> x = 6 :: (VMAX >= 7 && OK_M(7)) -> x = 7 \
-  :: (VMAX >= 8 && OK_M(8)) -> x = 8 :: (VMAX >= 9 && OK_M(9)) -> x = 9 \
+  :: (VMAX >= 0 AND_OK(0)) -> x = 0 :: (VMAX >= 1 AND_OK(1)) -> x = 1 \
+  :: (VMAX >= 2 AND_OK(2)) -> x = 2 :: (VMAX >= 3 AND_OK(3)) -> x = 3 \
+  :: (VMAX >= 4 AND_OK(4)) -> x = 4 :: (VMAX >= 5 AND_OK(5)) -> x = 5 \
+  :: (VMAX >= 6 AND_OK(6)) -> x = 6 :: (VMAX >= 7 AND_OK(7)) -> x = 7 \
+  :: (VMAX >= 8 AND_OK(8)) -> x = 8 :: (VMAX >= 9 AND_OK(9)) -> x = 9 \
   fi
-#endif
+#define CHOOSE_BIT(b) if :: b = 0 :: b = 1 fi
 
 #define RELEASE_ALL (st && he && rs)
 /* step 1: the conditions that release a latched emergency brake (REQ-BR-006) */

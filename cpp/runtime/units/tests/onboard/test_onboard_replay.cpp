@@ -766,7 +766,7 @@ TEST(OnboardReplay, BrakingVectorsWithConcretePatterns) {
   const std::size_t unit_vectors = l.headers.at("br.unit.jsonl").at("vector_count").get<std::size_t>();
   EXPECT_EQ(unit_vectors, 73U);
   EXPECT_EQ(replayed["br.unit.jsonl"], unit_vectors);
-  EXPECT_GT(with_restrictions["br.unit.jsonl"], 0U);
+  EXPECT_EQ(with_restrictions["br.unit.jsonl"], 40U);
   RecordProperty("replayed", std::to_string(replayed["br.jsonl"] + replayed["br.unit.jsonl"]));
   RecordProperty("replayed_unit_set", std::to_string(replayed["br.unit.jsonl"]));
   RecordProperty("with_restrictions_unit_set", std::to_string(with_restrictions["br.unit.jsonl"]));
