@@ -63,10 +63,39 @@
  * goals; TRAPS adds the goal flags); ONE_START = one start point (a boundary variant:
  * every property is verified in it too, and it supplies the vectors of
  * ra.one_start.jsonl); WALK stops after MODEL_CYCLES cycles (random-walk vectors).
+ * UNIT (with WALK; random walks only, ra.unit.jsonl) is the on-board unit's environment,
+ * the one its external interface (TG pulses and IMU samples) can give the machine: the
+ * unit's times (MODEL_UNIT_*: the look-back and search of the start point, the spacing, the
+ * warm-up, the sections' times, all in 100 ms cycles) and only input sequences a sensor
+ * stream can produce (unit_inputs() below: one section under the standing train; the start
+ * point's age one the search can find in the history since the last restart; no TG motion
+ * in the first cycle of a history; the primary agrees only if the older, more tolerant
+ * candidate does, and exactly when the two start points are one, the oldest usable entry; one
+ * detection per walk). Its counters run to 100 and more, so it is not
+ * searched exhaustively: the properties are those verified in the default configuration.
  *
  * Annotations read by testgen: see models/tg.pml.
  */
 #include "ra_params.pml"
+#ifdef UNIT
+#ifndef WALK
+#error "UNIT is an environment for random walks (define WALK too)"
+#endif
+#undef MODEL_START_AGE
+#undef MODEL_SEARCH_EXTRA
+#undef MODEL_SPACING
+#undef MODEL_TMAX_LONG
+#undef MODEL_TMAX_SHORT
+#undef MODEL_WARMUP
+#undef MODEL_CYCLES
+#define MODEL_START_AGE MODEL_UNIT_START_AGE
+#define MODEL_SEARCH_EXTRA MODEL_UNIT_SEARCH_EXTRA
+#define MODEL_SPACING MODEL_UNIT_SPACING
+#define MODEL_TMAX_LONG MODEL_UNIT_TMAX_LONG
+#define MODEL_TMAX_SHORT MODEL_UNIT_TMAX_SHORT
+#define MODEL_WARMUP MODEL_UNIT_WARMUP
+#define MODEL_CYCLES MODEL_UNIT_CYCLES
+#endif
 
 #define CONFIRM MODEL_CONFIRM
 #define SPACING MODEL_SPACING
@@ -133,7 +162,15 @@ byte was_conf[2];
 byte late_m;               /* mutant only: the previous cycle's section margin */
 #endif
 #ifdef WALK
-byte ncycles;
+short ncycles;
+#endif
+#ifdef UNIT
+/* the unit's environment: the history index of the cycle (accepted cycles since the last
+ * restart, capped), the section under the train, whether a detection has happened, scratch */
+#define AGE_TOP (MODEL_START_AGE + MODEL_SEARCH_EXTRA)
+#define HL_CAP (MODEL_WARMUP + CONFIRM + AGE_TOP)
+byte hl, usec, u_r;
+bit eps, u_same, u_b;
 #endif
 /* ---- ghost: follows the inputs only ---------------------------------------------------- */
 byte g_run;                /* consecutive deviations in TG odometry with healthy sensors */
@@ -171,6 +208,25 @@ byte h_i;
 
 #define CHOOSE_BIT(b) if :: b = 0 :: b = 1 fi
 #define CHOOSE_SEC(s) if :: s = S_LONG :: s = S_STEEP :: s = S_SHORT fi
+#ifdef UNIT
+/* the start points the unit's search can give at history index hl (spec/design/ra.md §7):
+ * one found at MODEL_START_AGE .. min(AGE_TOP, hl - MODEL_WARMUP - CONFIRM) (its jerk
+ * conditions need CONFIRM entries after the first MODEL_WARMUP), or the search's fallback,
+ * the oldest usable point, min(AGE_TOP, hl - MODEL_WARMUP); an offset drawn from 6 bits */
+#define CHOOSE_AGE(a) \
+  u_r = 0; \
+  CHOOSE_BIT(u_b); u_r = u_r * 2 + u_b; CHOOSE_BIT(u_b); u_r = u_r * 2 + u_b; \
+  CHOOSE_BIT(u_b); u_r = u_r * 2 + u_b; CHOOSE_BIT(u_b); u_r = u_r * 2 + u_b; \
+  CHOOSE_BIT(u_b); u_r = u_r * 2 + u_b; CHOOSE_BIT(u_b); u_r = u_r * 2 + u_b; \
+  if \
+  :: hl >= MODEL_WARMUP + CONFIRM + MODEL_START_AGE -> \
+     a = MODEL_START_AGE + u_r % ((hl - MODEL_WARMUP - CONFIRM < AGE_TOP -> hl - MODEL_WARMUP - CONFIRM : AGE_TOP) \
+                                  - MODEL_START_AGE + 1) \
+  :: hl >= MODEL_WARMUP -> a = (hl - MODEL_WARMUP < AGE_TOP -> hl - MODEL_WARMUP : AGE_TOP) \
+  :: else -> a = 0 \
+  fi; \
+  u_r = 0; u_b = 0
+#else
 #define CHOOSE_AGE(a) \
   if \
   :: a = MODEL_START_AGE \
@@ -180,6 +236,7 @@ byte h_i;
   fi
 #if MODEL_SEARCH_EXTRA > 3
 #error "CHOOSE_AGE enumerates up to MODEL_SEARCH_EXTRA = 3: extend it"
+#endif
 #endif
 #ifdef WALK
 /* random walks: a sensor fails in 1 of 32 cycles, a balise is read in 1 of 4; a deviation
@@ -200,6 +257,41 @@ byte h_i;
 #else
 #define CHOOSE_OK(b) CHOOSE_BIT(b)
 #define CHOOSE_BALISE(b) CHOOSE_BIT(b)
+#endif
+
+#ifdef UNIT
+/* The inputs of a cycle in the unit's environment (random walks). A sensor fails in about 1
+ * of 512 cycles each (a failure restarts the history and the 40-cycle warm-up), a TG pulse
+ * before the trust comes in 1 of 32 cycles and never in the first cycle of a history (the
+ * odometry has no count to compare there); a deviation in 1 of 4 cycles, the agreement in 1
+ * of 2. The train stands on one section (chosen in the first cycle). The primary candidate
+ * agrees only when the second does: both integrate the same IMU stream from start points
+ * where it agrees with the TG, so they have one speed, and the second, 25 cycles older,
+ * allows the larger difference (design note §7); where the primary's start point is the
+ * oldest usable history entry, the second is clamped to it and the two agree alike. One detection per walk: the start-point
+ * search of a second one would look into the history the first compensation replaced. */
+inline unit_inputs() {
+  if :: ncycles == 1 -> CHOOSE_SEC(usec) :: else -> skip fi;
+  sec = usec;
+  CHOOSE_OK(imu); if :: !imu -> CHOOSE_LIKELY(imu); if :: !imu -> CHOOSE_LIKELY(imu) :: else -> skip fi :: else -> skip fi;
+  CHOOSE_OK(tg); if :: !tg -> CHOOSE_LIKELY(tg); if :: !tg -> CHOOSE_LIKELY(tg) :: else -> skip fi :: else -> skip fi;
+  CHOOSE_BALISE(bal);
+  if
+  :: mode == M_TG && eps && dcount == CONFIRM - 1 -> dev = 0
+  :: else -> CHOOSE_UNLIKELY(dev)
+  fi;
+  if
+  :: !trust && hl > 0 -> CHOOSE_OK(u_b); mv = 1 - u_b; u_b = 0
+  :: else -> mv = 0
+  fi;
+  CHOOSE_BIT(sa[0]);
+  if
+  :: u_same -> sa[1] = sa[0]
+  :: !u_same && sa[0] -> sa[1] = 1
+  :: else -> CHOOSE_BIT(sa[1])
+  fi;
+  CHOOSE_AGE(sage)
+}
 #endif
 
 /* ---- the cycle, design note §5 --------------------------------------------------------- */
@@ -636,8 +728,14 @@ init {
 #endif
        CLEAR_GOALS;
        /* the environment (see the header comment for the inputs fixed when not read) */
+#if defined(UNIT)
+       unit_inputs();
+#else
        CHOOSE_SEC(sec); CHOOSE_OK(imu); CHOOSE_OK(tg); CHOOSE_BALISE(bal);
-#ifdef WALK
+#endif
+#if defined(UNIT)
+       skip;
+#elif defined(WALK)
        if :: mode == M_COMP -> CHOOSE_UNLIKELY(dev) :: else -> CHOOSE_LIKELY(dev) fi;
        CHOOSE_MOTION(mv);
        CHOOSE_LIKELY(sa[0]); CHOOSE_LIKELY(sa[1]); CHOOSE_AGE(sage);
@@ -666,6 +764,14 @@ init {
          ghost();
          check();
          goals();
+#ifdef UNIT
+         /* the walks check every property at the unit's times as they go */
+         assert(!(v_detect || v_start || v_readh || v_timeout || v_stopped || v_limits || v_parallel ||
+                  v_balise || v_sensor || v_startup));
+         /* the history index of this cycle is hl: the start points are one at the oldest usable entry */
+         if :: detected -> eps = 1; u_same = (sage == hl - MODEL_WARMUP) :: else -> skip fi;
+         if :: HEALTHY -> if :: hl < HL_CAP -> hl++ :: else -> skip fi :: else -> hl = 0 fi;
+#endif
          clear_cycle()
        }
      }
@@ -693,6 +799,7 @@ ltl REQ_RA_015_startup { [] !v_startup }
 // @property REQ_RA_013_sensor REQ-RA-013 : an IMU or TG failure gives in the same cycle the stopped state with the failure as reason (IMU checked first), the stop demand and the invalid position, and discards every candidate
 ltl REQ_RA_013_sensor { [] !v_sensor }
 
+// @walks UNIT : the on-board unit's environment (random walks only, ra.unit.jsonl, replayed through the unit's sensor interface): the unit's times and the input sequences a TG and IMU stream can give the machine (unit_inputs())
 // @variant ONE_START start_points=1 : one start point (parallel_start_points = 1): every property is verified with a single candidate too, and the configuration supplies the vectors of ra.one_start.jsonl
 
 // @mutant MUTANT_TIMEOUT_OFF_BY_ONE violates REQ_RA_007_timeout : a candidate times out only above t_max + 1 (C++ FAULT_RA_TIMEOUT_OFF_BY_ONE)

@@ -170,6 +170,8 @@ def model_configurations(model_path: Path) -> list:
             add(c)
     for v in ann.variants:
         add(v.define)
+    for define, _ in ann.walk_only:
+        add(define)
     for g in ann.goals:
         add(g.config)
     for m in ann.mutants:

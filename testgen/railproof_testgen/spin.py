@@ -53,6 +53,9 @@ _GOAL = _annotation("goal", rf"(\d+)\s+{_REQS}:\s*(.*)")
 _MUT = _annotation("mutant", r"(\w+)\s+violates\s+(\S+)\s*:\s*(.*)")
 _ASSERT = _annotation("assert", rf"(\w+)\s+{_REQS}:\s*(.*)")
 _VARIANT = _annotation("variant", r"(\w+)(?:\s+(\w+)=(\w+))?\s*:\s*(.*)")
+# an environment given to random walks only (neither verified nor searched: its counters are
+# too large for an exhaustive search), e.g. a unit's environment at its real times
+_WALKS = _annotation("walks", r"(\w+)\s*:\s*(.*)")
 _CONFIG = re.compile(r"\[config\s+(\w+(?:\s+\w+)*)\]")
 _PAN_FLAGS = _annotation("pan_flags", r"((?:-D\w+(?:=\w+)?\s*)+)")
 
@@ -118,6 +121,7 @@ class Annotations:
     mutants: list = field(default_factory=list)
     asserts: dict = field(default_factory=dict)
     variants: list = field(default_factory=list)  # label -> (variables of the expression, requirements, text)
+    walk_only: list = field(default_factory=list)  # (define, text) of the // @walks configurations
     pan_flags: list = field(default_factory=list)  # extra -D flags for compiling pan (// @pan_flags)
 
 
@@ -139,6 +143,10 @@ def parse_annotations(model: Path) -> Annotations:
         m = _VARIANT.match(line)
         if m:
             ann.variants.append(Variant(m.group(1), m.group(2), m.group(3), m.group(4).strip()))
+            continue
+        m = _WALKS.match(line)
+        if m:
+            ann.walk_only.append((m.group(1), m.group(2).strip()))
             continue
         m = _ASSERT.match(line)
         if m:
@@ -618,6 +626,7 @@ def verify(model: Path, params_dir: Path, workdir: Path, out_json: Path, jobs: i
         "assertions": assertions,
         "variants": [{"define": v.define, "parameter": v.parameter, "bound": v.bound, "text": v.text}
                      for v in ann.variants],
+        "walk_only": [{"define": d, "text": t} for d, t in ann.walk_only],
         "mutants": mutants,
         "wall_time_s": round(time.monotonic() - t0, 1),
     }

@@ -381,6 +381,10 @@ class Generation:
             if v.define not in known:
                 raise SpecError(self.model, v.define, f"variant in which capability {capability} generates "
                                                       f"no vectors (capabilities/{capability}.py)")
+        for define, _ in ann.walk_only:
+            if define not in known or not part.configuration(define).walks:
+                raise SpecError(self.model, define, f"walk-only configuration in which capability {capability} "
+                                                    f"draws no random walks (capabilities/{capability}.py)")
         bounds = part.bounds(self.model, spin_mod.params_file(self.params_dir, self.model))
         self.target = Target(self.model, ann, bounds, spin_mod.spin_version())
         self.schema = self.spec_dir / "schemas" / f"vectors_{capability}.schema.json"

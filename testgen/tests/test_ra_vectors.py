@@ -4,7 +4,9 @@ conformance runner (railproof_conformance_ra) is the behavioural check of the ve
 tests check the parser, conversion, header and schema on hand-made model output, and that the
 vectors of a build (RAILPROOF_RESULTS_DIR) cover both machine configurations, follow design
 note §5 and hit the boundaries."""
+import json
 from pathlib import Path
+
 
 import pytest
 
@@ -39,7 +41,9 @@ def test_annotations_of_the_readhesion_model():
                        "REQ-RA-013", "REQ-RA-015"}
     # the one-start-point configuration: a variant, so every property is verified in it too
     assert [(v.define, v.parameter, v.bound) for v in ann.variants] == [("ONE_START", "start_points", "1")]
-    assert [c.define for c in PART.configurations] == [None, "ONE_START"]
+    assert [c.define for c in PART.configurations] == [None, "ONE_START", "UNIT"]
+    # the unit's environment: random walks only (neither verified nor searched)
+    assert [d for d, _ in ann.walk_only] == ["UNIT"]
     mutants = {m.name: m for m in ann.mutants}
     assert {f"MUTANT_{f}" for f in CPP_FAULTS} <= set(mutants)
     assert len(mutants) > len(CPP_FAULTS)
@@ -149,8 +153,8 @@ def test_schema_accepts_good_and_rejects_bad_records():
 
 def test_both_machine_configurations_have_their_file():
     vs = vector_set("ra")
-    assert sorted(vs.files) == ["ra.jsonl", "ra.one_start.jsonl"]
-    for name in vs.files:
+    assert sorted(vs.files) == ["ra.jsonl", "ra.one_start.jsonl", "ra.unit.jsonl"]
+    for name in ("ra.jsonl", "ra.one_start.jsonl"):
         one = name == "ra.one_start.jsonl"
         header = vs.header(name)
         assert header["configuration"] == ("ONE_START" if one else "default")
@@ -166,6 +170,46 @@ def test_both_machine_configurations_have_their_file():
     ids = {v["id"] for v in vs.vectors("ra.one_start.jsonl")}
     variant = [x for g in goals for x in g.get("variant_vectors", [])]
     assert variant and set(variant) <= ids
+
+
+def test_unit_set_is_the_unit_environment():
+    """ra.unit.jsonl (variant UNIT): the unit's times in the header, 50 walks of
+    MODEL_UNIT_CYCLES cycles, and in every vector the input sequences the on-board unit's sensor
+    stream can give (models/ra.pml, unit_inputs): one section, at most one detection, a start-point
+    age the search can find at the cycle's history index, no TG motion in a history's first cycle,
+    the primary agreeing only with the second (both alike where their start points are one)."""
+    vs = vector_set("ra")
+    h = vs.header("ra.unit.jsonl")
+    assert h["configuration"] == "UNIT"
+    p = h["parameters"]
+    assert (p["spacing_cycles"], p["warmup_cycles"], p["start_age_cycles"], p["model_cycles"]) == (25, 40, [25, 75], 300)
+    assert [s["max_compensation_cycles"] for s in p["sections"]] == [100, 100, 30]
+    vecs = vs.vectors("ra.unit.jsonl")
+    assert len(vecs) == 50 and all(v["kind"] == "random" and v["id"].startswith("RA-RANDOM-UNIT-S") for v in vecs)
+    detections = 0
+    for v in vecs:
+        steps = v["steps"]
+        assert len(steps) == 300
+        assert len({json.dumps(s["in"]["section"], sort_keys=True) for s in steps}) == 1, v["id"]
+        index, same, seen = 0, False, 0
+        for k, s in enumerate(steps):
+            i, o = s["in"], s["out"]
+            if index == 0:
+                assert not i["tg_moving"], (v["id"], k)
+            if o["detected"]:
+                seen += 1
+                age = i["start_age_cycles"]
+                top = min(75, index - 43)
+                assert age == min(75, index - 40) or 25 <= age <= top, (v["id"], k, age, index)
+                same = age == index - 40
+            if o["mode"] == "COMPENSATING" or steps[k - 1]["out"]["mode"] == "COMPENSATING" if k else False:
+                sa = i["speed_agrees"]
+                assert not sa[0] or sa[1], (v["id"], k)
+                assert not same or sa[0] == sa[1], (v["id"], k)
+            index = index + 1 if i["imu_ok"] and i["tg_ok"] else 0
+        assert seen <= 1, v["id"]
+        detections += seen
+    assert detections > 25
 
 
 def test_vectors_follow_the_design_note():

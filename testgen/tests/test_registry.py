@@ -53,7 +53,7 @@ def test_cmake_variables_and_fault_identifiers_come_from_the_registry(cli, tmp_p
 
 @pytest.mark.parametrize("change, file, entry, fragment", [
     # a model configuration the registry does not list
-    (("spec/capabilities.yaml", "configurations: [default, ONE_START]", "configurations: [default]"),
+    (("spec/capabilities.yaml", "configurations: [default, ONE_START, UNIT]", "configurations: [default]"),
      "spec/capabilities.yaml", "ra/ra", "configurations ['default'] differ from the model's"),
     # a registered fault without a site in the code
     (("cpp/runtime/lc/src/wayside/centre_scheduler.cpp", "RAILPROOF_FAULT(FAULT_LC_DEPART_WITHOUT_ALL_ACKS)",

@@ -5,4 +5,4 @@ railproof_runtime_module(onboard_unit CAPABILITY units SIDE onboard
   LINKS tg mb_onboard br ra lc_onboard messages)
 set(RAILPROOF_UNITS_ONBOARD_TESTS tests/onboard/test_onboard_unit.cpp tests/onboard/test_onboard_profile.cpp
     tests/onboard/test_onboard_replay.cpp tests/onboard/test_onboard_crossing_replay.cpp
-    tests/onboard/test_onboard_handover.cpp)
+    tests/onboard/test_onboard_handover.cpp tests/onboard/test_onboard_slip_replay.cpp)

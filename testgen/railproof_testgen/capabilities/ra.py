@@ -2,11 +2,13 @@
 (spec/design/ra.md §5: detection, parallel start points, re-adhesion judgement, maximum
 compensation time, margin in force, sensor failure, stop demand); the engine is vectors.py.
 
-Two machine configurations, each in a file of its own whose header records it: ra.jsonl (two
-parallel start points, the model's default configuration) and ra.one_start.jsonl (one start
-point, the model's variant ONE_START). Every goal of the default configuration is also
-searched in ONE_START, and each one reached there adds a vector to the one-start file
-(coverage entry "variant_vectors"). Random walks of MODEL_CYCLES cycles (configuration WALK).
+Three files, each with a header that records its configuration: ra.jsonl (two parallel start
+points, the model's default configuration) and ra.one_start.jsonl (one start point, the
+model's variant ONE_START). Every goal of the default configuration is also searched in
+ONE_START, and each one reached there adds a vector to the one-start file (coverage entry
+"variant_vectors"). Random walks of MODEL_CYCLES cycles (configuration WALK). ra.unit.jsonl:
+random walks of MODEL_UNIT_CYCLES cycles in UNIT, the on-board unit's environment at its real
+times (models/ra.pml, the MODEL_UNIT_* bounds), replayed through the unit's sensor interface.
 
 Units: model ticks are cycles and the model's margins are fed to the C++ as mm unchanged
 (header "units"): the machine only compares ages with t_max and takes minima and maxima of
@@ -28,8 +30,17 @@ NO_CANDIDATE = 255
 UNITS = "model ticks = cycles, model margin units = mm"
 BOUNDS = ("confirm", "start_age", "search_extra", "spacing", "tmax_long", "tmax_short", "margin_long",
           "margin_steep", "margin_short", "warmup", "cycles")
+# the bounds UNIT takes from MODEL_UNIT_<NAME> (models/ra.pml)
+UNIT_BOUNDS = ("start_age", "search_extra", "spacing", "tmax_long", "tmax_short", "warmup", "cycles")
 # start points of the machine in each configuration
-START_POINTS = {None: 2, "ONE_START": 1}
+START_POINTS = {None: 2, "ONE_START": 1, "UNIT": 2}
+
+
+def configured_bounds(b: dict, define) -> dict:
+    """The model bounds in force in a configuration."""
+    if define != "UNIT":
+        return b
+    return {**b, **{k: b[f"unit_{k}"] for k in UNIT_BOUNDS}}
 
 _RX_IN = re.compile(r"@IN cycle dev=([01]) sa0=([01]) sa1=([01]) imu=([01]) tg=([01]) bal=([01]) mv=([01]) "
                     r"sec=(\d+) age=(\d+)")
@@ -49,11 +60,15 @@ def section_limits(b: dict):
 class ReAdhesion(Part):
     prefix = "RA"
     configurations = (Configuration(None, walks=1),
-                      Configuration("ONE_START", suffix=".one_start", tag="ONESTART-", walks=5))
+                      Configuration("ONE_START", suffix=".one_start", tag="ONESTART-", walks=5),
+                      Configuration("UNIT", suffix=".unit", tag="UNIT-", walks=1))
     walk_events = "cycles"
 
     def bounds(self, model, params_pml):
-        return model_bounds(params_pml, BOUNDS)
+        return model_bounds(params_pml, BOUNDS + tuple(f"unit_{k}" for k in UNIT_BOUNDS))
+
+    def walk_length(self, bounds, define):
+        return configured_bounds(bounds, define)["cycles"]
 
     def parse_events(self, text):
         """Replay/simulation output -> list of (inputs, outputs) per cycle, raw model integers.
@@ -74,7 +89,7 @@ class ReAdhesion(Part):
 
     def to_steps(self, events, b, define):
         """Raw cycles -> vector steps (spec/schemas/vectors_ra.schema.json)."""
-        limits = section_limits(b)
+        limits = section_limits(configured_bounds(b, define))
         steps = []
         for i, o in events:
             if i["sec"] >= len(SECTIONS) or o["mode"] >= len(MODES) or o["reason"] >= len(REASONS):
@@ -124,7 +139,7 @@ class ReAdhesion(Part):
         return reqs
 
     def header(self, target, define):
-        b = target.bounds
+        b = configured_bounds(target.bounds, define)
         limits = section_limits(b)
         return target.header(
             configuration=self.configuration(define).name, units=UNITS,

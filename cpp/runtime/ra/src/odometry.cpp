@@ -426,6 +426,7 @@ void Odometry::Reject(const CycleInput& in, InputError imu_error, InputError tg_
   episode_gradient_x10_ = lim.gradient_x10;
   if (me == MachineError::kNone) prev_margin_mm_ = machine_.state().margin_mm;
   FillOutput(in, imu_error != InputError::kNone ? imu_error : tg_error, false, nullptr, me != MachineError::kNone);
+  out_.predicates = pr;
 }
 
 // @implements REQ-RA-003 REQ-RA-004 REQ-RA-005 REQ-RA-006 REQ-RA-007 REQ-RA-009 REQ-RA-010 REQ-RA-011 REQ-RA-012
@@ -567,6 +568,7 @@ void Odometry::Accept(const CycleInput& in) noexcept {
   FillOutput(in, InputError::kNone, true, &e, me != MachineError::kNone);
   out_.v_tg = v_tg_raw;  // the diagnostic shows the TG's own speed (the history may hold v_c)
   if (st.detected) out_.start_age_cycles = pr.start_age_cycles;
+  out_.predicates = pr;
   At(i).front_um = front_um_;
 }
 

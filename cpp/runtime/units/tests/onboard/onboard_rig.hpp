@@ -133,8 +133,12 @@ class Rig {
     unit_.emplace(std::move(*r.unit));
   }
   const OnboardOutputs& Step(const ra::test::Kinematics& k = {}, const ra::test::ImuValues& imu = {}) {
+    return StepWith(stream_.Next(k, imu));
+  }
+  // One cycle on sensor data the caller made (at the time of Sensors().Next()); the faults apply.
+  const OnboardOutputs& StepWith(const ra::CycleInput& sensors) {
     OnboardInputs in;
-    in.sensors = stream_.Next(k, imu);
+    in.sensors = sensors;
     in.now_ms = in.sensors.time_ms;
     if (imu_fault) {
       in.sensors.imu_count = static_cast<std::uint8_t>(ra::kImuSamplesPerCycle - 1);

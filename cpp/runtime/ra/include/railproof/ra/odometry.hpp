@@ -164,6 +164,7 @@ struct OdometryOutput {
   std::array<double, kMaxStartPoints> v_comp{};  // m/s, active candidates' speeds (baseline: upper bound)
   std::array<std::int64_t, kMaxStartPoints> x_comp_mm{};  // active candidates' fronts (IMU method)
   std::int32_t start_age_cycles = 0;   // primary start point age at the last detection
+  Predicates predicates{};             // what the state machine was given this cycle (design note §4)
   bool detected = false;
   std::int8_t adopted = kNoCandidate;
 };
