@@ -45,6 +45,17 @@ def test_environment_variant_without_a_parameter(tmp_path):
         ("NARROW", None, None, "a narrower environment"), ("WIDE", "limit", "wide_limit", "wider")]
 
 
+def test_walk_only_configuration_is_neither_verified_nor_a_variant(tmp_path):
+    m = tmp_path / "m.pml"
+    m.write_text("// @property P REQ-TG-001 : p\nltl P { [] true }\n"
+                 "// @walks UNIT : the unit's environment at its own times\n// @variant NARROW : narrower\n")
+    ann = spin.parse_annotations(m)
+    assert ann.walk_only == [("UNIT", "the unit's environment at its own times")]
+    assert [v.define for v in ann.variants] == ["NARROW"]  # only variants are verified and searched
+    from railproof_testgen.registry import model_configurations
+    assert model_configurations(m) == ["default", "NARROW", "UNIT"]
+
+
 def test_mutant_naming_an_unknown_property_is_rejected(tmp_path):
     m = tmp_path / "m.pml"
     m.write_text("// @property P REQ-TG-001 : p\nltl P { [] true }\n// @mutant MX violates Q : q\n")
