@@ -189,11 +189,35 @@ class Context:
                 self.tool_versions.append((prefix, fmt_value(v)))
         if self.inp.tool_versions is not None:
             flat("", self.inp.tool_versions)
+        self.identity = self._identity_rows()
         self.spin_versions = [(m["model"], m["spin_version"]) for m in self.models]
         self.doc_versions = [("Python", platform.python_version())] + list(
             package_versions(DOC_PACKAGES).items())
         gens = sorted({fmt_value(h.get("generator")) for _, h, _ in self.inp.vectors if h.get("generator")})
         self.generator_versions = [("vector generator", g) for g in gens]
+
+    def _identity_rows(self) -> list:
+        """[(what, value)] of the configuration record (inputs/configuration.json)."""
+        ident = self.inp.identity
+        if ident is None:
+            return []
+        src, srcs, b = ident["source"], ident["sources"], ident["build"]
+        rows = [("commit", src["commit"] or src.get("reason", "")), ("tree", src["tree"] or "-"),
+                ("commit date", src["commit_date"] or "-")]
+        if src["dirty"] is not None:
+            rows.append(("working tree", "as committed" if not src["dirty"] else
+                         f"{src['changed_count']} tracked file(s) changed since the commit: "
+                         + ", ".join(src["changed"])))
+        rows.append(("source files", f"{srcs['count']} files, SHA-256 over the sorted list {srcs['sha256']}"))
+        if b.get("build_dir_found"):
+            rows += [("build type", b["build_type"]), ("compiler", b["compiler"]),
+                     ("build-type flags", b["config_flags"])]
+            rows += [(f"compile flags ({k}, {i + 1} of {len(v)})", f) for k, v in b["compile_flags"].items()
+                     for i, f in enumerate(v)]
+            rows += [(f"option {k}", v) for k, v in b["options"].items()]
+        else:
+            rows.append(("build", b.get("reason", "")))
+        return rows
 
     # -- overall --------------------------------------------------------------------------
     def _verdict(self):

@@ -28,7 +28,7 @@ from pathlib import Path
 from .. import spec as spec_mod
 from .. import spin as spin_mod
 from ..errors import PipelineError, SpecError
-from . import junit
+from . import identity, junit
 
 TRACE_SCHEMA = "railproof/trace/1"
 REGISTRY_SCHEMA = "railproof/registry/1"
@@ -64,6 +64,7 @@ class Inputs:
     result_dirs: dict = field(default_factory=dict)   # dir -> [(file name, Path)] (results/<dir>/*)
     layout: dict | None = None
     tool_versions: dict | None = None
+    identity: dict | None = None                      # the configuration rendered from (identity.py)
     model_copies: dict = field(default_factory=dict)  # model path -> its copy under inputs/
     _rels: set = field(default_factory=set)
     extra: dict = field(default_factory=dict)         # what chapter modules load (by capability)
@@ -384,5 +385,7 @@ def load_inputs(spec_dir: Path, results_dir: Path, repo_root: Path) -> Inputs:
         load_result_dir(inp, directory)
     load_layout(inp)
     load_tool_versions(inp)
+    # the build directory is the one that holds the results
+    inp.identity = identity.collect(inp.repo_root, inp.results_dir.parent)
     chapters.load(inp)
     return inp

@@ -109,6 +109,11 @@ def copy_inputs(inp, inputs_dir: Path) -> list:
         dest.parent.mkdir(parents=True, exist_ok=True)
         shutil.copyfile(f.source, dest)
         rows.append({"path": f"inputs/{f.rel}", "sha256": sha256_file(dest), "bytes": dest.stat().st_size})
+    if inp.identity is not None:  # the configuration the package was rendered from (identity.py)
+        dest = inputs_dir / "configuration.json"
+        write(dest, json.dumps(inp.identity, indent=2, sort_keys=True) + "\n")
+        rows.append({"path": "inputs/configuration.json", "sha256": sha256_file(dest), "bytes": dest.stat().st_size})
+        rows.sort(key=lambda r: r["path"])
     return rows
 
 
