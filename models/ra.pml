@@ -268,13 +268,16 @@ byte h_i;
  * agrees only when the second does: both integrate the same IMU stream from start points
  * where it agrees with the TG, so they have one speed, and the second, 25 cycles older,
  * allows the larger difference (design note §7); where the primary's start point is the
- * oldest usable history entry, the second is clamped to it and the two agree alike. One detection per walk: the start-point
- * search of a second one would look into the history the first compensation replaced. */
+ * oldest usable history entry, the second is clamped to it and the two agree alike. One
+ * detection per walk: the start-point search of a second one would look into the history the
+ * first compensation replaced. */
+/* a sensor fails in 1 of 32 x 4 x 4 = 512 cycles */
+#define CHOOSE_HEALTH(b) \
+  CHOOSE_OK(b); if :: !b -> CHOOSE_LIKELY(b); if :: !b -> CHOOSE_LIKELY(b) :: else -> skip fi :: else -> skip fi
 inline unit_inputs() {
   if :: ncycles == 1 -> CHOOSE_SEC(usec) :: else -> skip fi;
   sec = usec;
-  CHOOSE_OK(imu); if :: !imu -> CHOOSE_LIKELY(imu); if :: !imu -> CHOOSE_LIKELY(imu) :: else -> skip fi :: else -> skip fi;
-  CHOOSE_OK(tg); if :: !tg -> CHOOSE_LIKELY(tg); if :: !tg -> CHOOSE_LIKELY(tg) :: else -> skip fi :: else -> skip fi;
+  CHOOSE_HEALTH(imu); CHOOSE_HEALTH(tg);
   CHOOSE_BALISE(bal);
   if
   :: mode == M_TG && eps && dcount == CONFIRM - 1 -> dev = 0
@@ -733,13 +736,11 @@ init {
 #else
        CHOOSE_SEC(sec); CHOOSE_OK(imu); CHOOSE_OK(tg); CHOOSE_BALISE(bal);
 #endif
-#if defined(UNIT)
-       skip;
-#elif defined(WALK)
+#if defined(WALK) && !defined(UNIT)
        if :: mode == M_COMP -> CHOOSE_UNLIKELY(dev) :: else -> CHOOSE_LIKELY(dev) fi;
        CHOOSE_MOTION(mv);
        CHOOSE_LIKELY(sa[0]); CHOOSE_LIKELY(sa[1]); CHOOSE_AGE(sage);
-#else
+#elif !defined(WALK)
        if :: HEALTHY && (mode != M_STOP || trust) -> CHOOSE_BIT(dev) :: else -> skip fi;
        if :: HEALTHY && !trust -> CHOOSE_BIT(mv) :: else -> skip fi;
        if

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import pytest
 
-from railproof_testgen import spin, vectors
+from railproof_testgen import spec, spin, vectors
 from railproof_testgen.capabilities import ra
 from railproof_testgen.capabilities.ra import PART
 from railproof_testgen.errors import PipelineError
@@ -181,15 +181,26 @@ def test_unit_set_is_the_unit_environment():
     vs = vector_set("ra")
     h = vs.header("ra.unit.jsonl")
     assert h["configuration"] == "UNIT"
+    # the header's times are the model_unit_* bounds, which are the runtime's times (spec/parameters/ra.yaml)
+    area = spec.load_parameters(REPO / "spec")["RA"]
+    bound = {k.removeprefix("model_unit_"): e["value"] for k, e in area["model_bounds"].items()
+             if k.startswith("model_unit_")}
+    rt = {k: e["value"] for k, e in area["parameters"].items()}
+    cycle = rt["cycle_ms"]
+    assert (bound["start_age"], bound["search_extra"], bound["spacing"], bound["warmup"], bound["tmax_short"]) == (
+        rt["lookback_ms"] // cycle, rt["search_depth_ms"] // cycle, rt["parallel_spacing_ms"] // cycle,
+        (rt["moving_average_ms"] + rt["tg_window_ms"]) // cycle, rt["min_compensation_ms"] // cycle)
     p = h["parameters"]
-    assert (p["spacing_cycles"], p["warmup_cycles"], p["start_age_cycles"], p["model_cycles"]) == (25, 40, [25, 75], 300)
-    assert [s["max_compensation_cycles"] for s in p["sections"]] == [100, 100, 30]
+    assert (p["spacing_cycles"], p["warmup_cycles"], p["start_age_cycles"], p["model_cycles"]) == (
+        bound["spacing"], bound["warmup"], [bound["start_age"], bound["start_age"] + bound["search_extra"]],
+        bound["cycles"])
+    assert [s["max_compensation_cycles"] for s in p["sections"]] == [bound["tmax_long"]] * 2 + [bound["tmax_short"]]
     vecs = vs.vectors("ra.unit.jsonl")
     assert len(vecs) == 50 and all(v["kind"] == "random" and v["id"].startswith("RA-RANDOM-UNIT-S") for v in vecs)
     detections = 0
     for v in vecs:
         steps = v["steps"]
-        assert len(steps) == 300
+        assert len(steps) == bound["cycles"]
         assert len({json.dumps(s["in"]["section"], sort_keys=True) for s in steps}) == 1, v["id"]
         index, same, seen = 0, False, 0
         for k, s in enumerate(steps):
@@ -199,9 +210,11 @@ def test_unit_set_is_the_unit_environment():
             if o["detected"]:
                 seen += 1
                 age = i["start_age_cycles"]
-                top = min(75, index - 43)
-                assert age == min(75, index - 40) or 25 <= age <= top, (v["id"], k, age, index)
-                same = age == index - 40
+                oldest = index - bound["warmup"]  # the oldest usable history entry's age
+                age_top = bound["start_age"] + bound["search_extra"]
+                found = bound["start_age"] <= age <= min(age_top, oldest - h["parameters"]["confirm_cycles"])
+                assert age == min(age_top, oldest) or found, (v["id"], k, age, index)
+                same = age == oldest
             if o["mode"] == "COMPENSATING" or steps[k - 1]["out"]["mode"] == "COMPENSATING" if k else False:
                 sa = i["speed_agrees"]
                 assert not sa[0] or sa[1], (v["id"], k)

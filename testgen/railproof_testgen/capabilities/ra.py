@@ -2,9 +2,9 @@
 (spec/design/ra.md §5: detection, parallel start points, re-adhesion judgement, maximum
 compensation time, margin in force, sensor failure, stop demand); the engine is vectors.py.
 
-Three files, each with a header that records its configuration: ra.jsonl (two parallel start
-points, the model's default configuration) and ra.one_start.jsonl (one start point, the
-model's variant ONE_START). Every goal of the default configuration is also searched in
+Three files, each with a header that records its configuration. ra.jsonl: two parallel start
+points, the model's default configuration; ra.one_start.jsonl: one start point, the model's
+variant ONE_START. Every goal of the default configuration is also searched in
 ONE_START, and each one reached there adds a vector to the one-start file (coverage entry
 "variant_vectors"). Random walks of MODEL_CYCLES cycles (configuration WALK). ra.unit.jsonl:
 random walks of MODEL_UNIT_CYCLES cycles in UNIT, the on-board unit's environment at its real
@@ -17,6 +17,7 @@ the limits, so the abstract values are exact.
 from __future__ import annotations
 
 import re
+from pathlib import Path
 
 from ..errors import PipelineError
 from ..vectors import Configuration, Part, model_bounds, model_lines
@@ -30,17 +31,22 @@ NO_CANDIDATE = 255
 UNITS = "model ticks = cycles, model margin units = mm"
 BOUNDS = ("confirm", "start_age", "search_extra", "spacing", "tmax_long", "tmax_short", "margin_long",
           "margin_steep", "margin_short", "warmup", "cycles")
-# the bounds UNIT takes from MODEL_UNIT_<NAME> (models/ra.pml)
-UNIT_BOUNDS = ("start_age", "search_extra", "spacing", "tmax_long", "tmax_short", "warmup", "cycles")
 # start points of the machine in each configuration
 START_POINTS = {None: 2, "ONE_START": 1, "UNIT": 2}
+# in UNIT the model redefines a bound by its unit counterpart: #define MODEL_<NAME> MODEL_UNIT_<NAME>
+_UNIT_BOUND = re.compile(r"^#define MODEL_(\w+) MODEL_UNIT_\1\s*$", re.M)
+
+
+def unit_bounds(model) -> tuple:
+    """The bounds the model's UNIT configuration takes from MODEL_UNIT_<NAME> (lower case)."""
+    return tuple(n.lower() for n in _UNIT_BOUND.findall(Path(model).read_text(encoding="utf-8")))
 
 
 def configured_bounds(b: dict, define) -> dict:
-    """The model bounds in force in a configuration."""
+    """The model bounds in force in a configuration (b holds the unit ones as unit_<name>)."""
     if define != "UNIT":
         return b
-    return {**b, **{k: b[f"unit_{k}"] for k in UNIT_BOUNDS}}
+    return {**b, **{k[len("unit_"):]: v for k, v in b.items() if k.startswith("unit_")}}
 
 _RX_IN = re.compile(r"@IN cycle dev=([01]) sa0=([01]) sa1=([01]) imu=([01]) tg=([01]) bal=([01]) mv=([01]) "
                     r"sec=(\d+) age=(\d+)")
@@ -65,7 +71,12 @@ class ReAdhesion(Part):
     walk_events = "cycles"
 
     def bounds(self, model, params_pml):
-        return model_bounds(params_pml, BOUNDS + tuple(f"unit_{k}" for k in UNIT_BOUNDS))
+        unit = unit_bounds(model)
+        if not unit:
+            raise PipelineError(f"{model}: no MODEL_UNIT_<NAME> redefinition for the configuration UNIT")
+        b = model_bounds(params_pml, BOUNDS + tuple(f"unit_{k}" for k in unit))
+        # only the bounds the model redefines are the UNIT configuration's
+        return {k: v for k, v in b.items() if not k.startswith("unit_") or k[len("unit_"):] in unit}
 
     def walk_length(self, bounds, define):
         return configured_bounds(bounds, define)["cycles"]

@@ -56,7 +56,14 @@ constexpr std::int64_t kLookback = p::lookback_ms / p::cycle_ms;
 constexpr std::int64_t kSearch = p::search_depth_ms / p::cycle_ms;
 constexpr std::int64_t kSpacing = p::parallel_spacing_ms / p::cycle_ms;
 constexpr std::int64_t kUsable = (p::moving_average_ms + p::tg_window_ms) / p::cycle_ms;  // first usable entry
-constexpr double kMaxRate = static_cast<double>(p::imu_max_rate_mrad_s) / 1000.0;
+// the stream stays within 95 % of the IMU's ranges the odometry validates
+constexpr double kRateLimit = 0.95 * static_cast<double>(p::imu_max_rate_mrad_s) / 1000.0;
+constexpr double kSampleLimit = 0.95 * static_cast<double>(p::imu_max_accel_mm_s2) / 1000.0;
+// the TG's resolution below low_speed_mm_s: one pulse in the 1 s window (m/s, and m/s^2 over 1 s)
+constexpr double kRes = ra::test::kPulseUm * 1e-6;
+
+// The agreement tolerance of a candidate `cycles` old (design note §4).
+double Tolerance(std::int64_t cycles, double res) { return kRate * static_cast<double>(cycles) * kDt + res; }
 
 // The variant's times are the unit's (spec/parameters/ra.yaml, model_unit_*).
 static_assert(p::model::model_unit_start_age == kLookback);
@@ -103,9 +110,8 @@ StartPlan Plan(const json& steps, std::vector<std::string>& problems) {
       // The train moves while the TG stands (a slide): by the first compensating cycle the
       // candidates' speed lies between their two agreement tolerances, from where each
       // agreement the steps ask is a small change away.
-      const double res = ra::test::kPulseUm * 1e-6;
-      const double tol0 = kRate * static_cast<double>(age + 1) * kDt + res;
-      const double tol1 = kRate * static_cast<double>(d - plan.s1 + 1) * kDt + res;
+      const double tol0 = Tolerance(age + 1, kRes);
+      const double tol1 = Tolerance(d - plan.s1 + 1, kRes);
       if (age >= 1) plan.pre_accel = 0.5 * (tol0 + tol1) / ((static_cast<double>(age) - 0.5) * kDt);
       auto mark = [&](std::int64_t from, std::int64_t to, int v) {
         for (std::int64_t j = std::max<std::int64_t>(from, 0); j <= to; ++j) {
@@ -133,13 +139,9 @@ StartPlan Plan(const json& steps, std::vector<std::string>& problems) {
 // A_p of the coming cycle before its IMU samples are chosen).
 class SlipReplay {
  public:
-  SlipReplay(const Line& line, const std::vector<ra::OdometrySection>& sections)
-      : cfg_(Config(line)), rig_(cfg_) {
-    ra::OdometryConfig oc = cfg_.odometry;
-    oc.sections = sections.data();
-    oc.section_count = static_cast<int>(sections.size());
-    EXPECT_EQ(ra::Odometry::Create(oc, shadow_), ra::ConfigError::kNone);
-    ta_ = static_cast<double>(oc.detect_threshold_mm_s2) / 1000.0;
+  explicit SlipReplay(const Line& line) : cfg_(Config(line)), rig_(cfg_), balise_(line.balises.front()) {
+    EXPECT_EQ(ra::Odometry::Create(cfg_.odometry, shadow_), ra::ConfigError::kNone);  // line's sections
+    ta_ = static_cast<double>(cfg_.odometry.detect_threshold_mm_s2) / 1000.0;
   }
 
   void Run(const json& steps, const StartPlan& plan, std::vector<std::string>& problems) {
@@ -175,7 +177,8 @@ class SlipReplay {
     return w;
   }
 
-  double Threshold(double v_tg) const { return ta_ + (v_tg < kLowSpeed ? ra::test::kPulseUm * 1e-6 : 0.0); }
+  static double Resolution(double v_tg) { return v_tg < kLowSpeed ? kRes : 0.0; }
+  double Threshold(double v_tg) const { return ta_ + Resolution(v_tg); }
 
   // Odometry cycles of candidate c after this cycle (its start point's history index).
   std::int64_t CandidateCycles(std::size_t c) const { return index_ - start_index_[c]; }
@@ -196,12 +199,21 @@ class SlipReplay {
     return in;
   }
 
+  // The coming cycle's 3 s a_x window: how many samples it averages (n) and the sum of the
+  // n - 1 it already holds (1e-9 m/s^2); its average is (sum + sample) / n.
+  struct Window {
+    std::int64_t n = 1, sum = 0;
+  };
+  Window Coming() const {
+    Window w{std::min<std::int64_t>(index_ + 1, kAvgCycles), 0};
+    for (std::int64_t j = 1; j < w.n; ++j) w.sum += samples_[samples_.size() - static_cast<std::size_t>(j)];
+    return w;
+  }
+
   // The a_x sample (in 1e-9 m/s^2) that puts the compared average at q (given A_p).
   std::int64_t SampleFor(double q, double ap) const {
-    const std::int64_t n = std::min<std::int64_t>(index_ + 1, kAvgCycles);
-    std::int64_t sum = 0;
-    for (std::int64_t j = 1; j < n; ++j) sum += samples_[samples_.size() - static_cast<std::size_t>(j)];
-    return std::llround((q + ap) * static_cast<double>(n) * 1e9) - sum;
+    const Window w = Coming();
+    return std::llround((q + ap) * static_cast<double>(w.n) * 1e9) - w.sum;
   }
   // The compared average (a_x average minus A_p) of a cycle outside compensation: on the
   // step's side of the threshold (before the detection within kHover of it), moving by at most
@@ -210,35 +222,28 @@ class SlipReplay {
   // it to the level value, at which the cycle's sample equals the average it makes (so that the
   // samples stay calm).
   double ChooseQ(bool dev, int jerk, bool narrow, bool level_wanted, double thr, double ap) const {
-    const std::int64_t n = std::min<std::int64_t>(index_ + 1, kAvgCycles);
-    std::int64_t sum = 0;
-    for (std::int64_t j = 1; j < n; ++j) sum += samples_[samples_.size() - static_cast<std::size_t>(j)];
-    const double level = n == 1 ? prev_q_ : (static_cast<double>(sum) * 1e-9 - static_cast<double>(n) * ap) /
-                                               static_cast<double>(n - 1);
-    std::vector<std::pair<double, double>> side;
-    if (dev) {
-      side.emplace_back(thr + kEdge, narrow ? thr + kHover : thr + 1.0);
-    } else {
-      side.emplace_back(narrow ? thr - kHover : -(thr - kEdge), thr - kEdge);
-    }
+    const Window w = Coming();
+    const double level = w.n == 1 ? prev_q_ : (static_cast<double>(w.sum) * 1e-9 - static_cast<double>(w.n) * ap) /
+                                                 static_cast<double>(w.n - 1);
+    // the step's side of the threshold
+    const double lo = dev ? thr + kEdge : (narrow ? thr - kHover : -(thr - kEdge));
+    const double hi = dev ? (narrow ? thr + kHover : thr + 1.0) : thr - kEdge;
     std::vector<std::pair<double, double>> allowed;
-    for (const auto& [lo, hi] : side) {
-      if (jerk > 0) {
-        allowed.emplace_back(std::max(lo, prev_q_ - kJerkHolds), std::min(hi, prev_q_ + kJerkHolds));
-      } else if (jerk < 0) {
-        allowed.emplace_back(lo, std::min(hi, prev_q_ - kJerkFails));
-        allowed.emplace_back(std::max(lo, prev_q_ + kJerkFails), hi);
-      } else {
-        allowed.emplace_back(lo, hi);
-      }
+    if (jerk > 0) {
+      allowed.emplace_back(std::max(lo, prev_q_ - kJerkHolds), std::min(hi, prev_q_ + kJerkHolds));
+    } else if (jerk < 0) {
+      allowed.emplace_back(lo, std::min(hi, prev_q_ - kJerkFails));
+      allowed.emplace_back(std::max(lo, prev_q_ + kJerkFails), hi);
+    } else {
+      allowed.emplace_back(lo, hi);
     }
     // before the detection near the threshold, so that a deviation can change within the jerk
     // conditions; after it the level value
     const double target = narrow && !level_wanted ? (dev ? thr + kNear : thr - kNear) : level;
     double best = std::nan("");
-    for (const auto& [lo, hi] : allowed) {
-      if (lo > hi) continue;
-      const double q = std::clamp(target, lo, hi);
+    for (const auto& [a, b] : allowed) {
+      if (a > b) continue;
+      const double q = std::clamp(target, a, b);
       if (std::isnan(best) || std::fabs(q - target) < std::fabs(best - target)) best = q;
     }
     return best;
@@ -290,17 +295,17 @@ class SlipReplay {
           wy = (std::asin(std::clamp(target / kG, -0.99, 0.99)) - theta_[1]) / kDt;
         }
       }
-      if (std::fabs(wy) > kMaxRate * 0.98 || std::fabs(ax) > 45.0) {
+      if (std::fabs(wy) > kRateLimit || std::fabs(ax) > kSampleLimit) {
         chk.Fail("the stream cannot make this step within the IMU's range (a_x " + std::to_string(ax) +
                  ", pitch rate " + std::to_string(wy) + ")");
         return;
       }
     }
-    if (balise) rig_.Balise(7);
+    if (balise) rig_.Balise(balise_.id);
     const ra::CycleInput sensors = Sensors(in.at("imu_ok").get<bool>(), in.at("tg_ok").get<bool>(), ax, wy);
     (void)rig_.Sensors().Next();  // the rig's clock: the stream's standing cycle is replaced
     ra::CycleInput fixed = sensors;
-    if (balise) fixed.balise = ra::BaliseFix{ra::test::kInitialFrontMm};
+    if (balise) fixed.balise = ra::BaliseFix{balise_.position_mm};  // as the unit's track database has it
     const ra::OdometryOutput& od = shadow_.Step(fixed);
     const OnboardOutputs& o = rig_.StepWith(sensors);
     if (o.sent) rig_.Answer(messages::KeepAlive{});
@@ -390,14 +395,11 @@ class SlipReplay {
   // gravity term, and the pitch rate makes up the rest.
   bool Compensate(const Want& w, double ap, double thr, double v_tg, double& ax, double& wy, rc::Checker& chk) {
     const ra::OdometryOutput& now = shadow_.output();
-    const double res = v_tg < kLowSpeed ? ra::test::kPulseUm * 1e-6 : 0.0;
     std::array<double, 2> tol{};
-    for (std::size_t c = 0; c < 2; ++c) tol[c] = kRate * static_cast<double>(CandidateCycles(c)) * kDt + res;
+    for (std::size_t c = 0; c < 2; ++c) tol[c] = Tolerance(CandidateCycles(c), Resolution(v_tg));
     // the a_x interval of the deviation band
-    const std::int64_t n = std::min<std::int64_t>(index_ + 1, kAvgCycles);
-    std::int64_t sum = 0;
-    for (std::int64_t j = 1; j < n; ++j) sum += samples_[samples_.size() - static_cast<std::size_t>(j)];
-    const double nn = static_cast<double>(n), s = static_cast<double>(sum) * 1e-9;
+    const Window win = Coming();
+    const double nn = static_cast<double>(win.n), s = static_cast<double>(win.sum) * 1e-9;
     // q intervals of the step's deviation: a narrow band near the threshold, which keeps the
     // samples calm (the pitch then sets the acceleration; preferred), and the whole band
     const bool dev = w.dev.value_or(false);
@@ -411,49 +413,50 @@ class SlipReplay {
     double best_cost = 1e300;
     const int grid = static_cast<int>(kMaxA / 0.02);
     for (std::size_t set = 0; set < band_sets.size(); ++set) {
-    const auto& bands = band_sets[set];
-    for (int g = -grid; g <= grid; ++g) {
-      const double a0 = 0.02 * g;
-      const double free_x = a0 + kG * std::sin(theta_[0]);  // the pitch unchanged
-      double x = std::nan("");
-      for (const auto& [qlo, qhi] : bands) {
-        const double c = std::clamp(free_x, nn * (qlo + ap) - s, nn * (qhi + ap) - s);
-        if (std::isnan(x) || std::fabs(c - free_x) < std::fabs(x - free_x)) x = c;
+      const auto& bands = band_sets[set];
+      for (int g = -grid; g <= grid; ++g) {
+        const double a0 = 0.02 * g;
+        const double free_x = a0 + kG * std::sin(theta_[0]);  // the pitch unchanged
+        double x = std::nan("");
+        for (const auto& [qlo, qhi] : bands) {
+          const double c = std::clamp(free_x, nn * (qlo + ap) - s, nn * (qhi + ap) - s);
+          if (std::isnan(x) || std::fabs(c - free_x) < std::fabs(x - free_x)) x = c;
+        }
+        const double sin0 = (x - a0) / kG;  // the pitch gravity must take for that acceleration
+        if (std::fabs(sin0) > 0.95) continue;
+        const double th0 = std::asin(sin0);
+        const double rate = (th0 - theta_[0]) / kDt;
+        if (std::fabs(rate) > kRateLimit || std::fabs(x) > kSampleLimit) continue;
+        bool ok = true;
+        double v0 = 0;
+        for (std::size_t c = 0; c < 2; ++c) {
+          const double a = x - kG * std::sin(theta_[c] + rate * kDt);
+          const double v = now.v_comp[c] + 0.5 * (a_prev_[c] + a) * kDt;
+          if (c == 0) v0 = v;
+          if (!w.sa[c]) continue;
+          const double d = std::fabs(v_tg - v);
+          ok = ok && (*w.sa[c] ? d <= tol[c] - kSpeedMargin : d >= tol[c] + kSpeedMargin);
+        }
+        if (!ok) continue;
+        // Keep the next cycle free to reach every agreement: the pitch rate lets the acceleration
+        // change by 3 m/s^2 or more in a cycle (within +-kMaxA), so the next speed lies in a window
+        // (the trapezoid); it must hold the border between the tolerances with room for either
+        // side of it (on either sign of the speed difference).
+        const double a_lo = std::max(-kMaxA, a0 - 3.0), a_hi = std::min(kMaxA, a0 + 3.0);
+        const double w_lo = v0 - v_tg + 0.5 * (a0 + a_lo) * kDt, w_hi = v0 - v_tg + 0.5 * (a0 + a_hi) * kDt;
+        const double border = pref + kRate * kDt, room = 0.5 * (tol[1] - tol[0]) + 0.01;
+        const bool free_next = (w_lo <= border - room && w_hi >= border + room) ||
+                               (w_lo <= -border - room && w_hi >= -border + room);
+        const double cost = (required ? 0.2 : 1.0) * std::fabs(std::fabs(v0 - v_tg) - pref) + 0.3 * std::fabs(a0) +
+                            0.5 * std::fabs(th0) + (free_next ? 0.0 : 10.0) +
+                            (std::fabs(th0) > 0.6 ? 10.0 : 0.0) + (set == 0 ? 0.0 : 0.05) +
+                            3.0 * std::fabs((s + x) / nn - ap - (dev ? thr + 0.015 : thr - 0.015));
+        if (cost < best_cost) {
+          best_cost = cost;
+          ax = x;
+          wy = rate;
+        }
       }
-      const double th0 = std::asin(std::clamp((x - a0) / kG, -0.95, 0.95));
-      if (std::fabs((x - a0) / kG) > 0.95) continue;
-      const double rate = (th0 - theta_[0]) / kDt;
-      if (std::fabs(rate) > kMaxRate * 0.95 || std::fabs(x) > 45.0) continue;
-      bool ok = true;
-      double v0 = 0;
-      for (std::size_t c = 0; c < 2; ++c) {
-        const double a = x - kG * std::sin(theta_[c] + rate * kDt);
-        const double v = now.v_comp[c] + 0.5 * (a_prev_[c] + a) * kDt;
-        if (c == 0) v0 = v;
-        if (!w.sa[c]) continue;
-        const double d = std::fabs(v_tg - v);
-        ok = ok && (*w.sa[c] ? d <= tol[c] - kSpeedMargin : d >= tol[c] + kSpeedMargin);
-      }
-      if (!ok) continue;
-      // Keep the next cycle free to reach every agreement: the pitch rate lets the acceleration
-      // change by 3 m/s^2 or more in a cycle (within +-kMaxA), so the next speed lies in a window
-      // (the trapezoid); it must hold the border between the tolerances with room for either
-      // side of it (on either sign of the speed difference).
-      const double a_lo = std::max(-kMaxA, a0 - 3.0), a_hi = std::min(kMaxA, a0 + 3.0);
-      const double w_lo = v0 - v_tg + 0.5 * (a0 + a_lo) * kDt, w_hi = v0 - v_tg + 0.5 * (a0 + a_hi) * kDt;
-      const double border = pref + kRate * kDt, room = 0.5 * (tol[1] - tol[0]) + 0.01;
-      const bool free_next = (w_lo <= border - room && w_hi >= border + room) ||
-                             (w_lo <= -border - room && w_hi >= -border + room);
-      const double cost = (required ? 0.2 : 1.0) * std::fabs(std::fabs(v0 - v_tg) - pref) + 0.3 * std::fabs(a0) +
-                          0.5 * std::fabs(th0) + (free_next ? 0.0 : 10.0) +
-                          (std::fabs(th0) > 0.6 ? 10.0 : 0.0) + (set == 0 ? 0.0 : 0.05) +
-                          3.0 * std::fabs((s + x) / nn - ap - (dev ? thr + 0.015 : thr - 0.015));
-      if (cost < best_cost) {
-        best_cost = cost;
-        ax = x;
-        wy = rate;
-      }
-    }
     }
     if (best_cost == 1e300) {
       chk.Fail("no a_x and pitch rate give this step's deviation and speed agreement (candidate speeds " +
@@ -465,6 +468,7 @@ class SlipReplay {
 
   OnboardConfig cfg_;
   Rig rig_;
+  BaliseEntry balise_;  // the balise the steps read (the line's first)
   ra::Odometry shadow_;
   double ta_ = 0;
   std::int64_t pulses_ = 0, edge_us_ = 0;
@@ -496,7 +500,7 @@ TEST(OnboardReplay, OdometryVectorsOfTheUnitEnvironment) {
     std::vector<std::string> problems;
     const StartPlan plan = Plan(steps, problems);
     if (problems.empty()) {
-      SlipReplay replay(line, line.sections);
+      SlipReplay replay(line);
       replay.Run(steps, plan, problems);
     }
     for (const std::string& pr : problems) ADD_FAILURE() << pr;
